@@ -1,0 +1,55 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file increment.hpp
+/// @brief The incremental driver (seed eqs. 12–18): one local problem per load increment or
+/// time step, friction path dependent through the previous tangential gap.
+
+#include "flexcontact/problem.hpp"
+#include <stdexcept>
+
+namespace flexcontact
+{
+/// @brief Holds W, μ and the history (gap x, force λ, states) between increments.
+///
+/// The caller gives for each increment the total q = B u_p + x0 (u_p = K⁻¹ p of the total
+/// load). The gap is x = W λ + q; the tangential slip of the increment is x_t − x_t,prev, so
+/// the local problem solved is u = W λ + (q − P_t x_prev), with P_t keeping tangential rows.
+class IncrementalSolver
+{
+public:
+  /// @throws std::invalid_argument on sizes that disagree, μ < 0 or non-finite, W not finite
+  IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions options = {});
+
+  /// @brief Solve one increment; starts from the last increment's λ and states.
+  /// @throws std::invalid_argument if q has the wrong size or is not finite
+  /// @throws ConvergenceError if no solver of the chain converges (history left unchanged)
+  const SolveReport& step(const Eigen::Ref<const Vector>& q_total);
+
+  const Vector& gap() const { return x_; }          ///< total gap x of the last increment
+  const Vector& force() const { return lambda_; }   ///< λ of the last increment
+  const std::vector<PairState>& states() const { return states_; }
+  const SolveReport& last() const { return last_; }
+  int dim() const { return dim_; }
+  int pairs() const { return static_cast<int>(mu_.size()); }
+  const Matrix& W() const { return W_; }
+
+private:
+  int dim_;
+  Matrix W_;
+  Vector mu_;
+  SolverOptions options_;
+  Vector x_, lambda_;
+  std::vector<PairState> states_;
+  SolveReport last_;
+};
+
+/// @brief Thrown when no local solver converged; what() names solvers, iterations, residual.
+class ConvergenceError : public std::runtime_error
+{
+public:
+  ConvergenceError(const std::string& what, SolveReport report)
+      : std::runtime_error(what), report(std::move(report)) {}
+  SolveReport report;
+};
+} // namespace flexcontact

@@ -1,0 +1,77 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file problem.hpp
+/// @brief The condensed frictional contact problem of one increment, and what a solver reports.
+///
+/// Unknowns are ordered pair by pair, normal first: pair k owns entries [k·d, k·d + d) of λ
+/// and u, with d = 2 (n, t) or d = 3 (n, t1, t2). λ_n ≥ 0 is compression, u_n ≥ 0 separation.
+/// The local problem of one increment is
+///
+///     u = W λ + q,
+///     u_n ≥ 0, λ_n ≥ 0, u_n λ_n = 0,                        (Signorini)
+///     |λ_t| ≤ μ λ_n, |λ_t| < μ λ_n ⇒ u_t = 0,
+///     u_t ≠ 0 ⇒ λ_t = −μ λ_n u_t/|u_t|                       (Coulomb)
+///
+/// where u_t is the tangential slip of the increment. The incremental driver (increment.hpp)
+/// builds q from the total gap so that this holds.
+
+#include <Eigen/Dense>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace flexcontact
+{
+using Matrix = Eigen::MatrixXd;
+using Vector = Eigen::VectorXd;
+
+/// @brief Contact state of one pair (the seed's three states).
+enum class PairState : int
+{
+  open = 0,  ///< no contact: λ = 0
+  stick = 1, ///< closed, no slip in the increment
+  slip = 2   ///< closed, sliding: λ_t on the boundary of the Coulomb cone
+};
+
+/// @brief Read-only view of one local problem u = W λ + q with friction coefficients μ.
+struct ProblemView
+{
+  int dim;                           ///< 2 or 3 unknowns per pair
+  Eigen::Ref<const Matrix> W;        ///< (m·d)×(m·d), symmetric positive semi-definite
+  Eigen::Ref<const Vector> q;        ///< m·d
+  Eigen::Ref<const Vector> mu;       ///< m, each ≥ 0
+  int pairs() const { return static_cast<int>(q.size()) / dim; }
+};
+
+/// @brief Options shared by every local solver.
+struct SolverOptions
+{
+  /// Converged when the relative natural-map residual (residual.hpp) is below this.
+  double tolerance = 1e-10;
+  /// Iteration cap of each solver (active-set switches, Newton steps, or projection sweeps
+  /// for the projection solver, which gets 50× this many).
+  int max_iterations = 100;
+  /// Solvers tried in order until one converges; names as in solver_names(). Empty: the
+  /// default chain, most robust first.
+  std::vector<std::string> chain;
+  /// Print one line per iteration to stderr (debugging).
+  bool verbose = false;
+};
+
+/// @brief What a local solver did and found.
+struct SolveReport
+{
+  Vector lambda;                    ///< contact forces, local frame, pair by pair
+  Vector u;                         ///< W λ + q
+  std::vector<PairState> states;    ///< per pair, from (λ, u)
+  std::string solver;               ///< name of the solver whose answer this is
+  int iterations = 0;               ///< iterations of that solver
+  int state_changes = 0;            ///< pair state switches (active set), 0 for others
+  double residual = std::numeric_limits<double>::infinity(); ///< relative natural-map residual
+  bool converged = false;
+  bool cycled = false;              ///< active set revisited an earlier state vector
+  std::vector<std::string> attempts; ///< one line per solver tried, in order, with outcome
+};
+
+} // namespace flexcontact

@@ -1,0 +1,27 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file residual.hpp
+/// @brief Coulomb cone projection and the natural-map residual that certifies an answer.
+
+#include "flexcontact/problem.hpp"
+
+namespace flexcontact
+{
+/// @brief Project one pair's force (λ_n, λ_t…) onto the Coulomb cone |λ_t| ≤ μ λ_n, in place.
+/// @param r pointer to d values, normal first
+void project_on_cone(double* r, int dim, double mu);
+
+/// @brief Relative natural-map residual of λ for the problem, 0 for an exact solution.
+///
+/// Per pair, with the De Saxcé modified velocity û = (u_n + μ|u_t|, u_t) and ρ_k = 1/W_kk of
+/// the pair's normal row (so that ρ u is a force):  e_k = λ_k − P_K(λ_k − ρ_k û_k).
+/// Returned: ‖e‖ / max(‖λ‖, ‖ρ q‖, tiny). It vanishes exactly on the solutions of the
+/// Signorini–Coulomb problem, whatever solver produced λ.
+double natural_map_residual(const ProblemView& p, const Eigen::Ref<const Vector>& lambda);
+
+/// @brief State of each pair read from (λ, u): open, stick or slip, with a relative tolerance.
+std::vector<PairState> classify_states(const ProblemView& p,
+                                       const Eigen::Ref<const Vector>& lambda,
+                                       const Eigen::Ref<const Vector>& u, double tol = 1e-8);
+} // namespace flexcontact

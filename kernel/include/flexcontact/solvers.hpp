@@ -1,0 +1,44 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file solvers.hpp
+/// @brief The local contact solvers behind one interface, and the dispatcher with fallback.
+///
+/// Every solver takes the problem, a starting λ (may be empty: zero start) and options, and
+/// returns a SolveReport with its residual computed by natural_map_residual(), never by
+/// trusting its own stopping test. A solver that does not converge returns converged=false;
+/// it does not throw.
+
+#include "flexcontact/problem.hpp"
+
+namespace flexcontact
+{
+/// @brief Feng–Touzot active-set method (the seed's eqs. 12–18): stick/slip/open rows, 2D slip
+/// direction ±t, 3D slip direction from the previous iterate (the seed's explicit method).
+/// Cycle detection: a revisited state vector stops it with cycled=true.
+/// @param states0 starting states per pair (empty: all stick)
+SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                             const std::vector<PairState>& states0, const SolverOptions& opt);
+
+/// @brief The seed's projection method: De Saxcé–Feng bi-potential fixed point,
+/// λ_k ← P_K(λ_k − ρ_k (u_k + μ|u_t,k| n)), as a Gauss–Seidel sweep over pairs.
+SolveReport solve_projection(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                             const SolverOptions& opt);
+
+/// @brief Semi-smooth (generalised) Newton on the Alart–Curnier augmented Lagrangian
+/// formulation, with a line search on the natural-map merit.
+SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                            const SolverOptions& opt);
+
+/// @brief Names accepted in SolverOptions::chain: "active_set", "projection", "newton_ac".
+std::vector<std::string> solver_names();
+
+/// @brief Default order, most robust first.
+std::vector<std::string> default_chain();
+
+/// @brief Try the solvers of opt.chain (or default_chain()) in order until one converges.
+/// The report is the converging solver's, with `attempts` listing every try; if none
+/// converges it is the best one's (smallest residual) with converged=false.
+SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                  const std::vector<PairState>& states0, const SolverOptions& opt);
+} // namespace flexcontact
