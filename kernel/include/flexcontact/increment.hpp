@@ -26,6 +26,11 @@ public:
   /// @throws ConvergenceError if no solver of the chain converges (history left unchanged)
   const SolveReport& step(const Eigen::Ref<const Vector>& q_total);
 
+  /// @brief Gap before the first increment (default 0): the tangential slip of the first
+  /// increment is measured from it, so an initial tangential offset is not taken as slip.
+  /// @throws std::invalid_argument on a wrong size or non-finite values
+  void set_initial_gap(const Eigen::Ref<const Vector>& x0);
+
   const Vector& gap() const { return x_; }          ///< total gap x of the last increment
   const Vector& force() const { return lambda_; }   ///< λ of the last increment
   const std::vector<PairState>& states() const { return states_; }

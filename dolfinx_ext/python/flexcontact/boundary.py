@@ -1,0 +1,37 @@
+"""Dirichlet conditions on tagged facets, with values that load steps can change."""
+from __future__ import annotations
+
+import numpy as np
+import dolfinx.fem
+from petsc4py import PETSc
+
+from . import compat
+
+
+def dirichlet(V, facet_tags, value: int, components=None, displacement_m=0.0):
+    """Prescribe displacement components [m] on the facets tagged ``value``.
+
+    Returns ``(bcs, constants)``: a list of DirichletBC (one per component) and the
+    dolfinx Constants holding their values, so that a load step can change them in place
+    (``constants[0].value = -1e-4``).
+    """
+    msh = V.mesh
+    gdim = msh.geometry.dim
+    facets = facet_tags.find(value) if hasattr(facet_tags, "find") else \
+        facet_tags.indices[facet_tags.values == value]
+    from mpi4py import MPI
+    if msh.comm.allreduce(len(facets), op=MPI.SUM) == 0:
+        raise ValueError(f"Dirichlet condition: no facet carries the tag value {value} "
+                         f"(values present: {sorted(set(np.unique(facet_tags.values).tolist()))})")
+    comps = list(range(gdim)) if components is None else list(components)
+    vals = np.broadcast_to(np.asarray(displacement_m, dtype=float), (len(comps),))
+    bcs, consts = [], []
+    for c, v in zip(comps, vals):
+        if not 0 <= c < gdim:
+            raise ValueError(f"Dirichlet condition on tag {value}: component {c} does not "
+                             f"exist in {gdim}D")
+        k = dolfinx.fem.Constant(msh, PETSc.ScalarType(v))
+        dofs = compat.locate_component_dofs(V, c, facets)
+        bcs.append(dolfinx.fem.dirichletbc(k, dofs, V.sub(c)))
+        consts.append(k)
+    return bcs, consts

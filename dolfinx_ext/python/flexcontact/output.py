@@ -1,0 +1,78 @@
+"""Results on disk: XDMF time series for ParaView, summary.json, the increment table."""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+import dolfinx.io
+
+from . import compat
+
+
+class ResultWriter:
+    """One XDMF file, one time step per increment; closed (and so complete) on every exit.
+
+    Use as a context manager so that a failing increment leaves a readable file with the
+    increments done before it.
+    """
+
+    def __init__(self, folder, name: str, msh, tags=()):
+        self.folder = Path(folder)
+        if msh.comm.rank == 0:
+            self.folder.mkdir(parents=True, exist_ok=True)
+        msh.comm.barrier()
+        self.path = self.folder / f"{name}.xdmf"
+        self._xdmf = dolfinx.io.XDMFFile(msh.comm, str(self.path), "w")
+        compat.write_mesh_and_tags(self._xdmf, msh, tags)
+
+    def write(self, problem, t: float):
+        for f in problem.fields():
+            self._xdmf.write_function(f, t)
+
+    def close(self):
+        if self._xdmf is not None:
+            self._xdmf.close()
+            self._xdmf = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+
+def results_folder(name: str) -> Path:
+    """``results/<name>/`` under the current directory (or $FLEXCONTACT_RESULTS)."""
+    base = Path(os.environ.get("FLEXCONTACT_RESULTS", "results"))
+    return base / name
+
+
+def write_summary(folder, data: dict, comm=MPI.COMM_WORLD):
+    """Write ``summary.json`` on rank 0 (NumPy values become plain numbers)."""
+    if comm.rank != 0:
+        return
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+
+    def plain(o):
+        if isinstance(o, (np.floating, np.integer)):
+            return o.item()
+        if isinstance(o, np.ndarray):
+            return o.tolist()
+        if hasattr(o, "__dataclass_fields__"):
+            return asdict(o)
+        raise TypeError(f"cannot write {type(o)} to JSON")
+
+    tmp = folder / "summary.json.tmp"
+    tmp.write_text(json.dumps(data, indent=2, default=plain))
+    tmp.replace(folder / "summary.json")
+
+
+def increments_table(summaries) -> list[dict]:
+    return [asdict(s) for s in summaries]

@@ -1,0 +1,392 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file bind_kernel.cpp
+/// @brief Thin Python bindings of the kernel (kernel/include/flexcontact), numpy in and out.
+
+#include "bindings.h"
+
+#include <flexcontact/increment.hpp>
+#include <flexcontact/pairs.hpp>
+#include <flexcontact/problem.hpp>
+#include <flexcontact/residual.hpp>
+#include <flexcontact/solvers.hpp>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <sstream>
+
+namespace py = pybind11;
+using namespace flexcontact;
+
+namespace
+{
+using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
+
+/// @brief Pair states as a numpy int array (0 open, 1 stick, 2 slip).
+py::array_t<int> states_to_array(const std::vector<PairState>& s)
+{
+  py::array_t<int> a(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i)
+    a.mutable_at(i) = static_cast<int>(s[i]);
+  return a;
+}
+
+/// @brief Pair states from a numpy int array or None (empty).
+std::vector<PairState> states_from(const std::optional<IntArray>& a)
+{
+  std::vector<PairState> s;
+  if (!a)
+    return s;
+  for (py::ssize_t i = 0; i < a->size(); ++i)
+  {
+    int v = a->data()[i];
+    if (v < 0 or v > 2)
+      throw std::invalid_argument("pair state " + std::to_string(v)
+                                  + " is not 0 (open), 1 (stick) or 2 (slip)");
+    s.push_back(static_cast<PairState>(v));
+  }
+  return s;
+}
+
+/// @brief Check the sizes of one local problem u = W λ + q with friction μ.
+void check_problem(int dim, const Matrix& W, const Vector& q, const Vector& mu,
+                   const Vector& lambda0, std::size_t n_states = 0)
+{
+  if (dim != 2 and dim != 3)
+    throw std::invalid_argument("dim must be 2 or 3, got " + std::to_string(dim));
+  const auto n = q.size();
+  if (n != dim * mu.size())
+    throw std::invalid_argument("q has " + std::to_string(n) + " entries, expected dim·m = "
+                                + std::to_string(dim * mu.size()));
+  if (W.rows() != n or W.cols() != n)
+    throw std::invalid_argument("W is " + std::to_string(W.rows()) + "x"
+                                + std::to_string(W.cols()) + ", expected " + std::to_string(n)
+                                + "x" + std::to_string(n));
+  if (lambda0.size() != 0 and lambda0.size() != n)
+    throw std::invalid_argument("lambda0 has " + std::to_string(lambda0.size())
+                                + " entries, expected 0 or " + std::to_string(n));
+  if (n_states != 0 and n_states != static_cast<std::size_t>(mu.size()))
+    throw std::invalid_argument("states0 has " + std::to_string(n_states)
+                                + " entries, expected 0 or m = " + std::to_string(mu.size()));
+}
+
+Vector or_empty(const std::optional<Vector>& v) { return v ? *v : Vector(); }
+
+/// @brief B as COO triplets (rows, cols, vals) and its shape.
+py::tuple triplets(const Eigen::SparseMatrix<double>& B)
+{
+  std::vector<std::int64_t> rows, cols;
+  std::vector<double> vals;
+  for (int k = 0; k < B.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(B, k); it; ++it)
+    {
+      rows.push_back(it.row());
+      cols.push_back(it.col());
+      vals.push_back(it.value());
+    }
+  return py::make_tuple(py::array_t<std::int64_t>(rows.size(), rows.data()),
+                        py::array_t<std::int64_t>(cols.size(), cols.data()),
+                        py::array_t<double>(vals.size(), vals.data()),
+                        py::make_tuple(B.rows(), B.cols()));
+}
+
+/// @brief B from COO triplets (duplicates summed).
+Eigen::SparseMatrix<double> from_triplets(const py::array_t<std::int64_t>& rows,
+                                          const py::array_t<std::int64_t>& cols,
+                                          const py::array_t<double>& vals,
+                                          std::pair<std::int64_t, std::int64_t> shape)
+{
+  if (rows.size() != cols.size() or rows.size() != vals.size())
+    throw std::invalid_argument("rows, cols and vals must have the same length");
+  std::vector<Eigen::Triplet<double>> t;
+  for (py::ssize_t i = 0; i < rows.size(); ++i)
+  {
+    auto r = rows.data()[i], c = cols.data()[i];
+    if (r < 0 or r >= shape.first or c < 0 or c >= shape.second)
+      throw std::invalid_argument("triplet (" + std::to_string(r) + ", " + std::to_string(c)
+                                  + ") outside the shape");
+    t.emplace_back(r, c, vals.data()[i]);
+  }
+  Eigen::SparseMatrix<double> B(shape.first, shape.second);
+  B.setFromTriplets(t.begin(), t.end());
+  return B;
+}
+
+std::string report_repr(const SolveReport& r)
+{
+  std::ostringstream s;
+  s << "SolveReport(solver='" << r.solver << "', converged=" << (r.converged ? "True" : "False")
+    << ", iterations=" << r.iterations << ", state_changes=" << r.state_changes
+    << ", residual=" << r.residual << ", cycled=" << (r.cycled ? "True" : "False")
+    << ", pairs=" << r.states.size() << ")";
+  return s.str();
+}
+} // namespace
+
+void flexcontact::bind_kernel(py::module& m)
+{
+  // ---- exceptions ----------------------------------------------------------------------
+  static py::exception<ConvergenceError> convergence_error(m, "ConvergenceError",
+                                                           PyExc_RuntimeError);
+  py::register_exception_translator(
+      [](std::exception_ptr p)
+      {
+        try
+        {
+          if (p)
+            std::rethrow_exception(p);
+        }
+        catch (const ConvergenceError& e)
+        {
+          // The exception carries the best report as attribute `report`.
+          py::object type = py::reinterpret_borrow<py::object>(convergence_error.ptr());
+          py::object inst = type(e.what());
+          inst.attr("report") = py::cast(e.report);
+          PyErr_SetObject(convergence_error.ptr(), inst.ptr());
+        }
+      });
+
+  // ---- problem.hpp ---------------------------------------------------------------------
+  py::enum_<PairState>(m, "PairState", "Contact state of a pair")
+      .value("open", PairState::open)
+      .value("stick", PairState::stick)
+      .value("slip", PairState::slip);
+
+  py::class_<SolverOptions>(m, "SolverOptions", "Options shared by every local solver")
+      .def(py::init<>())
+      .def(py::init(
+               [](double tolerance, int max_iterations, std::vector<std::string> chain,
+                  bool verbose)
+               {
+                 SolverOptions o;
+                 o.tolerance = tolerance;
+                 o.max_iterations = max_iterations;
+                 o.chain = std::move(chain);
+                 o.verbose = verbose;
+                 return o;
+               }),
+           py::arg("tolerance") = 1e-10, py::arg("max_iterations") = 100,
+           py::arg("chain") = std::vector<std::string>(), py::arg("verbose") = false)
+      .def_readwrite("tolerance", &SolverOptions::tolerance)
+      .def_readwrite("max_iterations", &SolverOptions::max_iterations)
+      .def_readwrite("chain", &SolverOptions::chain)
+      .def_readwrite("verbose", &SolverOptions::verbose)
+      .def("__repr__",
+           [](const SolverOptions& o)
+           {
+             std::ostringstream s;
+             s << "SolverOptions(tolerance=" << o.tolerance
+               << ", max_iterations=" << o.max_iterations << ", chain=[";
+             for (std::size_t i = 0; i < o.chain.size(); ++i)
+               s << (i ? ", " : "") << "'" << o.chain[i] << "'";
+             s << "], verbose=" << (o.verbose ? "True" : "False") << ")";
+             return s.str();
+           });
+
+  py::class_<SolveReport>(m, "SolveReport", "What a local solver did and found")
+      .def(py::init<>())
+      .def_readonly("lambda_", &SolveReport::lambda)
+      .def_property_readonly("lambda", [](const SolveReport& r) { return r.lambda; })
+      .def_readonly("u", &SolveReport::u)
+      .def_property_readonly("states", [](const SolveReport& r) { return states_to_array(r.states); })
+      .def_readonly("solver", &SolveReport::solver)
+      .def_readonly("iterations", &SolveReport::iterations)
+      .def_readonly("state_changes", &SolveReport::state_changes)
+      .def_readonly("residual", &SolveReport::residual)
+      .def_readonly("converged", &SolveReport::converged)
+      .def_readonly("cycled", &SolveReport::cycled)
+      .def_readonly("attempts", &SolveReport::attempts)
+      .def("__repr__", &report_repr);
+
+  // ---- pairs.hpp -----------------------------------------------------------------------
+  py::class_<ContactPair>(m, "ContactPair", "One slave node against a master point")
+      .def(py::init<>())
+      .def(py::init(
+               [](int slave, std::vector<int> masters, std::vector<double> weights,
+                  const Matrix& frame)
+               {
+                 ContactPair p;
+                 p.slave = slave;
+                 p.masters = std::move(masters);
+                 p.weights = std::move(weights);
+                 p.frame = frame;
+                 return p;
+               }),
+           py::arg("slave"), py::arg("masters"), py::arg("weights"), py::arg("frame"))
+      .def_readwrite("slave", &ContactPair::slave)
+      .def_readwrite("masters", &ContactPair::masters)
+      .def_readwrite("weights", &ContactPair::weights)
+      .def_readwrite("frame", &ContactPair::frame);
+
+  m.def(
+      "frame_from_normal", [](const Vector& n) { return frame_from_normal(n); }, py::arg("n"),
+      "Local frame (rows n, t[, t2]) from a unit outward normal");
+
+  m.def(
+      "gap_operator",
+      [](int dim, int n_nodes, const std::vector<ContactPair>& pairs)
+      { return triplets(gap_operator(dim, n_nodes, pairs)); },
+      py::arg("dim"), py::arg("n_nodes"), py::arg("pairs"),
+      "B as (rows, cols, vals, shape) COO triplets; row block k is T_k (e_s - sum_j w_j e_j)");
+
+  m.def(
+      "initial_gap",
+      [](const std::vector<ContactPair>& pairs, const Matrix& X) { return initial_gap(pairs, X); },
+      py::arg("pairs"), py::arg("X"), "x0_k = T_k (X_s - sum_j w_j X_j); X is n_nodes x d");
+
+  m.def(
+      "delassus",
+      [](const std::vector<ContactPair>& pairs, int n_nodes, int dim, const Matrix& F)
+      { return delassus(gap_operator(dim, n_nodes, pairs), F); },
+      py::arg("pairs"), py::arg("n_nodes"), py::arg("dim"), py::arg("F"),
+      "W = B F* B^T (symmetrised) with B built from the pairs");
+  m.def(
+      "delassus",
+      [](const py::array_t<std::int64_t>& rows, const py::array_t<std::int64_t>& cols,
+         const py::array_t<double>& vals, std::pair<std::int64_t, std::int64_t> shape,
+         const Matrix& F)
+      {
+        if (F.rows() != shape.second or F.cols() != shape.second)
+          throw std::invalid_argument("F is " + std::to_string(F.rows()) + "x"
+                                      + std::to_string(F.cols()) + ", B has "
+                                      + std::to_string(shape.second) + " columns");
+        return delassus(from_triplets(rows, cols, vals, shape), F);
+      },
+      py::arg("rows"), py::arg("cols"), py::arg("vals"), py::arg("shape"), py::arg("F"),
+      "W = B F* B^T (symmetrised) with B given as COO triplets");
+
+  // ---- residual.hpp --------------------------------------------------------------------
+  m.def(
+      "project_on_cone",
+      [](Vector r, double mu)
+      {
+        const int dim = static_cast<int>(r.size());
+        if (dim != 2 and dim != 3)
+          throw std::invalid_argument("a pair force has 2 or 3 entries");
+        project_on_cone(r.data(), dim, mu);
+        return r;
+      },
+      py::arg("r"), py::arg("mu"), "Projection of one pair's force onto the Coulomb cone");
+
+  m.def(
+      "natural_map_residual",
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu, const Vector& lambda)
+      {
+        check_problem(dim, W, q, mu, lambda);
+        if (lambda.size() != q.size())
+          throw std::invalid_argument("lambda must have as many entries as q");
+        ProblemView p{dim, W, q, mu};
+        return natural_map_residual(p, lambda);
+      },
+      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lam"),
+      "Relative natural-map residual of lambda for u = W lambda + q (0 for a solution)");
+
+  m.def(
+      "classify_states",
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu, const Vector& lambda,
+         double tol)
+      {
+        check_problem(dim, W, q, mu, lambda);
+        if (lambda.size() != q.size())
+          throw std::invalid_argument("lambda must have as many entries as q");
+        ProblemView p{dim, W, q, mu};
+        Vector u = W * lambda + q;
+        return states_to_array(classify_states(p, lambda, u, tol));
+      },
+      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lam"),
+      py::arg("tol") = 1e-8, "Pair states (0 open, 1 stick, 2 slip) read from lambda");
+
+  // ---- solvers.hpp ---------------------------------------------------------------------
+  m.def(
+      "solve",
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
+         const std::optional<Vector>& lambda0, const std::optional<IntArray>& states0,
+         const SolverOptions& options)
+      {
+        Vector l0 = or_empty(lambda0);
+        auto s0 = states_from(states0);
+        check_problem(dim, W, q, mu, l0, s0.size());
+        ProblemView p{dim, W, q, mu};
+        py::gil_scoped_release release;
+        return solve(p, l0, s0, options);
+      },
+      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
+      py::arg("states0") = py::none(), py::arg("options") = SolverOptions(),
+      "Try the solvers of options.chain in order until one converges; returns a SolveReport");
+
+  m.def(
+      "solve_active_set",
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
+         const std::optional<Vector>& lambda0, const std::optional<IntArray>& states0,
+         const SolverOptions& options)
+      {
+        Vector l0 = or_empty(lambda0);
+        auto s0 = states_from(states0);
+        check_problem(dim, W, q, mu, l0, s0.size());
+        ProblemView p{dim, W, q, mu};
+        py::gil_scoped_release release;
+        return solve_active_set(p, l0, s0, options);
+      },
+      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
+      py::arg("states0") = py::none(), py::arg("options") = SolverOptions(),
+      "Feng-Touzot active-set method (stick/slip/open rows)");
+
+  m.def(
+      "solve_projection",
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
+         const std::optional<Vector>& lambda0, const SolverOptions& options)
+      {
+        Vector l0 = or_empty(lambda0);
+        check_problem(dim, W, q, mu, l0);
+        ProblemView p{dim, W, q, mu};
+        py::gil_scoped_release release;
+        return solve_projection(p, l0, options);
+      },
+      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
+      py::arg("options") = SolverOptions(),
+      "De Saxce-Feng bi-potential projection (Gauss-Seidel over pairs)");
+
+  m.def(
+      "solve_newton_ac",
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
+         const std::optional<Vector>& lambda0, const SolverOptions& options)
+      {
+        Vector l0 = or_empty(lambda0);
+        check_problem(dim, W, q, mu, l0);
+        ProblemView p{dim, W, q, mu};
+        py::gil_scoped_release release;
+        return solve_newton_ac(p, l0, options);
+      },
+      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
+      py::arg("options") = SolverOptions(),
+      "Semi-smooth Newton on the Alart-Curnier formulation");
+
+  m.def("solver_names", &solver_names, "Names accepted in SolverOptions.chain");
+  m.def("default_chain", &default_chain, "Default solver order, most robust first");
+
+  // ---- increment.hpp -------------------------------------------------------------------
+  py::class_<IncrementalSolver>(m, "IncrementalSolver",
+                                "Incremental driver: W, mu and the history between increments")
+      .def(py::init<int, Matrix, Vector, SolverOptions>(), py::arg("dim"), py::arg("W"),
+           py::arg("mu"), py::arg("options") = SolverOptions())
+      .def(
+          "step",
+          [](IncrementalSolver& s, const Vector& q)
+          {
+            py::gil_scoped_release release;
+            return s.step(q);
+          },
+          py::arg("q"),
+          "Solve one increment for the total q = B u_p + x0; returns a SolveReport. Raises "
+          "ConvergenceError (history unchanged) if no solver converges")
+      .def("gap", [](const IncrementalSolver& s) { return s.gap(); }, "Total gap x of the last increment")
+      .def("force", [](const IncrementalSolver& s) { return s.force(); }, "lambda of the last increment")
+      .def("states", [](const IncrementalSolver& s) { return states_to_array(s.states()); },
+           "Pair states of the last increment (0 open, 1 stick, 2 slip)")
+      .def("last", [](const IncrementalSolver& s) { return s.last(); }, "Report of the last increment")
+      .def("pairs", &IncrementalSolver::pairs)
+      .def("dim", &IncrementalSolver::dim)
+      .def_property_readonly("W", [](const IncrementalSolver& s) { return s.W(); });
+}

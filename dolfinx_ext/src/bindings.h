@@ -1,0 +1,16 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file bindings.h
+/// @brief Declarations of the parts of the `flexcontact._cpp` module.
+
+#include <pybind11/pybind11.h>
+
+namespace flexcontact
+{
+/// @brief flexibility, surface_nodes, set_nodal_values and their exceptions.
+void bind_dolfinx(pybind11::module& m);
+
+/// @brief The kernel: pairs, frames, gap operator, W, local solvers, incremental driver.
+void bind_kernel(pybind11::module& m);
+} // namespace flexcontact

@@ -1,0 +1,352 @@
+// Copyright flexcontact developers. MIT licence.
+
+#include "flexibility.h"
+#include "petsc_error.h"
+
+#include <algorithm>
+#include <iomanip>
+#include <sstream>
+#include <limits>
+#include <numeric>
+#include <mpi.h>
+#include <petscis.h>
+#include <vector>
+
+using namespace flexcontact;
+
+namespace
+{
+/// @brief Owns one reference to a PETSc Mat.
+struct OwnedMat
+{
+  Mat m = nullptr;
+  OwnedMat() = default;
+  OwnedMat(const OwnedMat&) = delete;
+  OwnedMat& operator=(const OwnedMat&) = delete;
+  ~OwnedMat()
+  {
+    if (m)
+      MatDestroy(&m);
+  }
+  Mat release()
+  {
+    Mat out = m;
+    m = nullptr;
+    return out;
+  }
+};
+
+/// @brief Owns one reference to a PETSc IS.
+struct OwnedIS
+{
+  IS is = nullptr;
+  OwnedIS() = default;
+  OwnedIS(const OwnedIS&) = delete;
+  OwnedIS& operator=(const OwnedIS&) = delete;
+  ~OwnedIS()
+  {
+    if (is)
+      ISDestroy(&is);
+  }
+};
+
+/// @brief Throw on the same condition on every rank: `fail` decided on rank 0 is broadcast.
+void throw_collective_if(MPI_Comm comm, bool fail_on_root, const std::string& what_on_root,
+                         const auto& make)
+{
+  int flag = fail_on_root ? 1 : 0;
+  MPI_Bcast(&flag, 1, MPI_INT, 0, comm);
+  if (!flag)
+    return;
+  int len = static_cast<int>(what_on_root.size());
+  MPI_Bcast(&len, 1, MPI_INT, 0, comm);
+  std::string what = what_on_root;
+  what.resize(len);
+  MPI_Bcast(what.data(), len, MPI_CHAR, 0, comm);
+  make(what);
+}
+
+/// @brief Check MUMPS's global status after a phase; INFOG is the same on every rank.
+void check_mumps(PetscErrorScope& err, Mat F, const char* phase)
+{
+  PetscInt infog1 = 0, info2 = 0;
+  err.check(MatMumpsGetInfog(F, 1, &infog1), "MatMumpsGetInfog");
+  if (infog1 >= 0)
+    return;
+  err.check(MatMumpsGetInfog(F, 2, &info2), "MatMumpsGetInfog");
+  std::string what = std::string("MUMPS failed in the ") + phase + ": INFOG(1)=" + std::to_string(infog1)
+                     + ", INFOG(2)=" + std::to_string(info2);
+  if (infog1 == -10)
+    what += " (numerically singular matrix)";
+  else if (infog1 == -9 or infog1 == -8 or infog1 == -13 or infog1 == -19)
+    what += " (not enough memory)";
+  throw MumpsError(what + "; see the MUMPS users' guide, 'Error diagnostics'",
+                   static_cast<int>(infog1));
+}
+
+/// @brief Number of null pivots MUMPS found (INFOG(28)), and the singular-K error if any.
+int check_null_pivots(PetscErrorScope& err, Mat F)
+{
+  PetscInt n = 0;
+  err.check(MatMumpsGetInfog(F, 28, &n), "MatMumpsGetInfog");
+  if (n > 0)
+  {
+    throw SingularStiffnessError(
+        "stiffness matrix is singular: " + std::to_string(n)
+        + " null pivots (a body has rigid-body modes: it is not held by Dirichlet conditions "
+          "or by springs)");
+  }
+  return static_cast<int>(n);
+}
+
+/// @brief MUMPS Cholesky of K, optionally with a centralised Schur complement on `schur`
+/// (rank 0's indices; empty elsewhere). Returns the factored matrix.
+Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, int& null_pivots)
+{
+  OwnedMat F;
+  err.check(MatGetFactor(K, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F.m), "MatGetFactor(mumps)");
+  // ICNTL(24) = 1: detect null pivots (reported in INFOG(28)) instead of dividing by ~0.
+  err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
+  if (schur)
+  {
+    MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+    OwnedIS is;
+    err.check(ISCreateGeneral(comm, static_cast<PetscInt>(schur->size()), schur->data(),
+                              PETSC_COPY_VALUES, &is.is),
+              "ISCreateGeneral");
+    err.check(MatFactorSetSchurIS(F.m, is.is), "MatFactorSetSchurIS");
+  }
+  MatFactorInfo info;
+  err.check(MatFactorInfoInitialize(&info), "MatFactorInfoInitialize");
+  err.check(MatCholeskyFactorSymbolic(F.m, K, nullptr, &info), "MatCholeskyFactorSymbolic");
+  check_mumps(err, F.m, "analysis");
+  err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
+  err.check(MatCholeskyFactorNumeric(F.m, K, &info), "MatCholeskyFactorNumeric");
+  check_mumps(err, F.m, "factorization");
+  null_pivots = check_null_pivots(err, F.m);
+  return F.release();
+}
+
+/// @brief F* = (K*_cc)⁻¹ on rank 0 from the Schur complement of the factor.
+Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
+                                 int n_c, double& schur_s, double& inverse_s)
+{
+  double t0 = MPI_Wtime();
+  OwnedMat S;
+  MatFactorSchurStatus status;
+  err.check(MatFactorCreateSchurComplement(F, &S.m, &status), "MatFactorCreateSchurComplement");
+  Eigen::MatrixXd Kcc;
+  if (rank == 0)
+  {
+    PetscInt m = 0, n = 0, lda = 0;
+    err.check(MatGetSize(S.m, &m, &n), "MatGetSize");
+    if (m != n_c or n != n_c)
+      throw std::runtime_error("Schur complement has size " + std::to_string(m) + "x"
+                               + std::to_string(n) + ", expected " + std::to_string(n_c));
+    err.check(MatDenseGetLDA(S.m, &lda), "MatDenseGetLDA");
+    const PetscScalar* a = nullptr;
+    err.check(MatDenseGetArrayRead(S.m, &a), "MatDenseGetArrayRead");
+    Kcc.resize(n_c, n_c);
+    for (int j = 0; j < n_c; ++j)
+      for (int i = 0; i < n_c; ++i)
+        Kcc(i, j) = a[i + static_cast<std::size_t>(j) * lda];
+    err.check(MatDenseRestoreArrayRead(S.m, &a), "MatDenseRestoreArrayRead");
+  }
+  double t1 = MPI_Wtime();
+  schur_s = t1 - t0;
+
+  Eigen::MatrixXd Fs;
+  bool singular = false;
+  std::string what;
+  if (rank == 0)
+  {
+    Eigen::MatrixXd Ks = 0.5 * (Kcc + Kcc.transpose());
+    Eigen::LLT<Eigen::MatrixXd> llt(Ks);
+    double rcond = llt.info() == Eigen::Success ? llt.rcond() : 0.0;
+    if (llt.info() != Eigen::Success or !(rcond > 1e3 * std::numeric_limits<double>::epsilon()))
+    {
+      singular = true;
+      std::ostringstream s;
+      s << "stiffness matrix is singular: the condensed stiffness K*_cc on the " << n_c
+        << " contact DOFs is not positive definite (reciprocal condition number "
+        << std::scientific << std::setprecision(2) << rcond
+        << "; a body has rigid-body modes that no Dirichlet condition removes)";
+      what = s.str();
+    }
+    else
+    {
+      Fs = llt.solve(Eigen::MatrixXd::Identity(n_c, n_c));
+      Fs = 0.5 * (Fs + Fs.transpose()).eval();
+    }
+  }
+  throw_collective_if(comm, singular, what,
+                      [](const std::string& w) { throw SingularStiffnessError(w); });
+  inverse_s = MPI_Wtime() - t1;
+  return Fs;
+}
+
+/// @brief F* = rows c of X, K X = E_c, gathered on rank 0.
+Eigen::MatrixXd multi_rhs_solve(PetscErrorScope& err, MPI_Comm comm, int rank, Mat K, Mat F,
+                                const std::vector<PetscInt>& dofs)
+{
+  const int n_c = static_cast<int>(dofs.size());
+  PetscInt m_local = 0, N = 0, rstart = 0, rend = 0;
+  err.check(MatGetLocalSize(K, &m_local, nullptr), "MatGetLocalSize");
+  err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
+  err.check(MatGetOwnershipRange(K, &rstart, &rend), "MatGetOwnershipRange");
+
+  OwnedMat E, X;
+  err.check(MatCreateDense(comm, m_local, PETSC_DECIDE, N, n_c, nullptr, &E.m), "MatCreateDense");
+  err.check(MatCreateDense(comm, m_local, PETSC_DECIDE, N, n_c, nullptr, &X.m), "MatCreateDense");
+  for (int j = 0; j < n_c; ++j)
+  {
+    if (dofs[j] >= rstart and dofs[j] < rend)
+      err.check(MatSetValue(E.m, dofs[j], j, 1.0, INSERT_VALUES), "MatSetValue");
+  }
+  err.check(MatAssemblyBegin(E.m, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  err.check(MatAssemblyEnd(E.m, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  err.check(MatAssemblyBegin(X.m, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  err.check(MatAssemblyEnd(X.m, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  err.check(MatMatSolve(F, E.m, X.m), "MatMatSolve");
+
+  // Local rows of X that are contact DOFs: (position in dofs, n_c values) each.
+  PetscInt lda = 0;
+  err.check(MatDenseGetLDA(X.m, &lda), "MatDenseGetLDA");
+  const PetscScalar* x = nullptr;
+  err.check(MatDenseGetArrayRead(X.m, &x), "MatDenseGetArrayRead");
+  std::vector<double> send;
+  for (int i = 0; i < n_c; ++i)
+  {
+    if (dofs[i] >= rstart and dofs[i] < rend)
+    {
+      send.push_back(i);
+      const std::size_t r = dofs[i] - rstart;
+      for (int j = 0; j < n_c; ++j)
+        send.push_back(x[r + static_cast<std::size_t>(j) * lda]);
+    }
+  }
+  err.check(MatDenseRestoreArrayRead(X.m, &x), "MatDenseRestoreArrayRead");
+
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  int count = static_cast<int>(send.size());
+  std::vector<int> counts(size), offsets(size + 1, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  std::partial_sum(counts.begin(), counts.end(), offsets.begin() + 1);
+  std::vector<double> recv(rank == 0 ? offsets.back() : 0);
+  MPI_Gatherv(send.data(), count, MPI_DOUBLE, recv.data(), counts.data(), offsets.data(),
+              MPI_DOUBLE, 0, comm);
+
+  Eigen::MatrixXd Fs;
+  if (rank == 0)
+  {
+    Fs.resize(n_c, n_c);
+    for (std::size_t p = 0; p < recv.size(); p += n_c + 1)
+    {
+      const int i = static_cast<int>(recv[p]);
+      for (int j = 0; j < n_c; ++j)
+        Fs(i, j) = recv[p + 1 + j];
+    }
+    Fs = 0.5 * (Fs + Fs.transpose()).eval();
+  }
+  return Fs;
+}
+} // namespace
+
+Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
+                                     const std::string& method)
+{
+  if (method != "schur" and method != "matmatsolve")
+    throw std::invalid_argument("unknown flexibility method '" + method
+                                + "' (expected 'schur' or 'matmatsolve')");
+  if (!K)
+    throw std::invalid_argument("the stiffness matrix is a null Mat");
+
+  PetscErrorScope err;
+  MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+
+  PetscInt M = 0, N = 0;
+  err.check(MatGetSize(K, &M, &N), "MatGetSize");
+  if (M != N)
+    throw std::invalid_argument("the stiffness matrix is not square (" + std::to_string(M) + "x"
+                                + std::to_string(N) + ")");
+
+  // Contact DOFs: validated on rank 0, then known everywhere.
+  std::vector<PetscInt> dofs;
+  std::string bad;
+  if (rank == 0)
+  {
+    dofs.assign(contact_dofs.begin(), contact_dofs.end());
+    std::vector<PetscInt> sorted = dofs;
+    std::sort(sorted.begin(), sorted.end());
+    if (!sorted.empty() and (sorted.front() < 0 or sorted.back() >= M))
+      bad = "contact DOF out of range [0, " + std::to_string(M) + "): "
+            + std::to_string(sorted.front() < 0 ? sorted.front() : sorted.back());
+    else if (auto it = std::adjacent_find(sorted.begin(), sorted.end()); it != sorted.end())
+      bad = "contact DOF " + std::to_string(*it) + " is listed twice";
+  }
+  throw_collective_if(comm, !bad.empty(), bad,
+                      [](const std::string& w) { throw std::invalid_argument(w); });
+  int n_c = static_cast<int>(dofs.size());
+  MPI_Bcast(&n_c, 1, MPI_INT, 0, comm);
+  dofs.resize(n_c);
+  MPI_Bcast(dofs.data(), n_c, MPIU_INT, 0, comm);
+
+  Flexibility out;
+  out.method = method;
+  out.n_contact_dofs = n_c;
+  err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
+
+  if (n_c == 0)
+  {
+    double t0 = MPI_Wtime();
+    out.factor = factorize(err, K, nullptr, out.null_pivots);
+    out.factorization_s = MPI_Wtime() - t0;
+    out.factorizations = 1;
+    out.F.resize(0, 0);
+  }
+  else if (method == "schur")
+  {
+    std::vector<PetscInt> root_dofs = rank == 0 ? dofs : std::vector<PetscInt>();
+    double t0 = MPI_Wtime();
+    OwnedMat F;
+    F.m = factorize(err, K, &root_dofs, out.null_pivots);
+    out.factorization_s = MPI_Wtime() - t0;
+    out.factorizations = 1;
+    out.F = inverse_of_schur(err, comm, rank, F.m, n_c, out.schur_s, out.inverse_s);
+    if (size == 1)
+      out.factor = F.release();
+    else
+    {
+      // PETSc's MatSolve does not support a Schur factor in parallel: plain factor for solves.
+      MatDestroy(&F.m);
+      double t1 = MPI_Wtime();
+      int np = 0;
+      out.factor = factorize(err, K, nullptr, np);
+      out.factorization_s += MPI_Wtime() - t1;
+      out.factorizations = 2;
+    }
+  }
+  else
+  {
+    double t0 = MPI_Wtime();
+    OwnedMat F;
+    F.m = factorize(err, K, nullptr, out.null_pivots);
+    out.factorization_s = MPI_Wtime() - t0;
+    out.factorizations = 1;
+    double t1 = MPI_Wtime();
+    out.F = multi_rhs_solve(err, comm, rank, K, F.m, dofs);
+    out.schur_s = MPI_Wtime() - t1;
+    out.factor = F.release();
+  }
+
+  double t[3] = {out.factorization_s, out.schur_s, out.inverse_s};
+  MPI_Allreduce(MPI_IN_PLACE, t, 3, MPI_DOUBLE, MPI_MAX, comm);
+  out.factorization_s = t[0];
+  out.schur_s = t[1];
+  out.inverse_s = t[2];
+  return out;
+}

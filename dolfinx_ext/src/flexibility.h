@@ -1,0 +1,75 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file flexibility.h
+/// @brief The flexibility F* = (K⁻¹)_cc on the contact DOFs from one MUMPS factorization
+/// (the seed's eqs. 4 and 6), without ever inverting K.
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <petscmat.h>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+namespace flexcontact
+{
+/// @brief K is singular (MUMPS found null pivots, or the condensed stiffness on the contact
+/// DOFs is singular): a body has rigid-body modes that no boundary condition removes.
+class SingularStiffnessError : public std::runtime_error
+{
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// @brief MUMPS reported an error (INFOG(1) < 0); what() holds INFOG(1) and INFO(2).
+class MumpsError : public std::runtime_error
+{
+public:
+  MumpsError(const std::string& what, int infog1)
+      : std::runtime_error(what), infog1(infog1) {}
+  int infog1; ///< MUMPS error code INFOG(1)
+};
+
+/// @brief F*, the factor of K that stays usable for solves, and what it cost.
+struct Flexibility
+{
+  /// (K⁻¹)_cc, n_c×n_c, rows/columns in the order of the given contact DOFs, symmetrised;
+  /// on rank 0 only (0×0 elsewhere).
+  Eigen::MatrixXd F;
+  /// MUMPS Cholesky factor of K; MatSolve(factor, b, x) gives x = K⁻¹ b. The caller owns
+  /// one reference (MatDestroy).
+  Mat factor = nullptr;
+  std::string method;            ///< "schur" or "matmatsolve"
+  int n_contact_dofs = 0;        ///< n_c
+  int null_pivots = 0;           ///< MUMPS INFOG(28)
+  int factorizations = 0;        ///< sparse factorizations performed (1, or 2: see flexibility())
+  double factorization_s = 0;    ///< analysis + numerical factorization (all factorizations)
+  double schur_s = 0;            ///< extracting K*_cc (schur) or the multi-RHS solve (matmatsolve)
+  double inverse_s = 0;          ///< dense Cholesky inversion of K*_cc (schur only)
+};
+
+/// @brief Compute the flexibility on the contact DOFs from a MUMPS Cholesky factorization.
+///
+/// K must be symmetric (it is flagged MAT_SYMMETRIC); rows/columns of Dirichlet DOFs hold
+/// the identity, as DOLFINx assembles them.
+///
+/// * "schur": MUMPS computes the Schur complement K*_cc = K_cc − K_cr K_rr⁻¹ K_rc inside the
+///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ by a dense Cholesky. In
+///   serial the returned factor is the same factorization (PETSc runs MUMPS's condensation
+///   and expansion phases around the Schur solve, so MatSolve gives K⁻¹b). PETSc cannot
+///   solve with a Schur factor in parallel, so with more than one rank a second, plain
+///   factorization is made for the returned factor (factorizations = 2).
+/// * "matmatsolve": one plain factorization and K X = E_c with the unit vectors of the
+///   contact DOFs as dense right-hand side; F* = X_c.
+///
+/// Collective on the communicator of K.
+/// @param K assembled stiffness (MATAIJ family)
+/// @param contact_dofs global row indices of the contact DOFs, on rank 0 (ignored elsewhere)
+/// @param method "schur" or "matmatsolve"
+/// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
+/// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)
+/// @throws MumpsError on a MUMPS failure, PetscError on a PETSc failure
+Flexibility flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
+                        const std::string& method = "schur");
+} // namespace flexcontact

@@ -1,0 +1,10 @@
+// Copyright flexcontact developers. MIT licence.
+
+#include "bindings.h"
+
+PYBIND11_MODULE(_cpp, m)
+{
+  m.doc() = "flexcontact C++ kernel and DOLFINx/PETSc bridge";
+  flexcontact::bind_kernel(m);
+  flexcontact::bind_dolfinx(m);
+}

@@ -1,0 +1,338 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file active_set.cpp
+/// @brief The Feng–Touzot active-set method (seed eqs. 12–18): each pair is stick, slip or
+/// open, each state replaces the pair's rows of u = W λ + q, the modified dense system is
+/// solved and the states are switched until none changes.
+
+#include "flexcontact/residual.hpp"
+#include "flexcontact/solvers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+namespace flexcontact
+{
+namespace
+{
+constexpr double tiny = std::numeric_limits<double>::min();
+
+/// @brief Throws if the problem's sizes, λ0 or states0 disagree.
+void check_inputs(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                  const std::vector<PairState>& states0)
+{
+  if (p.dim != 2 && p.dim != 3)
+    throw std::invalid_argument("flexcontact: active set: dim must be 2 or 3, got "
+                                + std::to_string(p.dim));
+  const auto n = p.q.size();
+  if (n % p.dim != 0 || p.W.rows() != n || p.W.cols() != n || p.mu.size() != n / p.dim)
+    throw std::invalid_argument("flexcontact: active set: sizes disagree (q "
+                                + std::to_string(n) + ", W " + std::to_string(p.W.rows())
+                                + "x" + std::to_string(p.W.cols()) + ", mu "
+                                + std::to_string(p.mu.size()) + ", dim "
+                                + std::to_string(p.dim) + ")");
+  if (lambda0.size() != 0 && lambda0.size() != n)
+    throw std::invalid_argument("flexcontact: active set: starting lambda has size "
+                                + std::to_string(lambda0.size()) + ", expected 0 or "
+                                + std::to_string(n));
+  if (lambda0.size() != 0 && !lambda0.allFinite())
+    throw std::invalid_argument("flexcontact: active set: starting lambda is not finite");
+  if (!states0.empty() && static_cast<Eigen::Index>(states0.size()) != n / p.dim)
+    throw std::invalid_argument("flexcontact: active set: " + std::to_string(states0.size())
+                                + " starting states for " + std::to_string(n / p.dim)
+                                + " pairs");
+}
+
+/// @brief Compliance c_k of pair k's normal row, used to scale the rows that state a force
+/// (λ = 0, friction law) so that every row of the modified system has the units and the
+/// size of a W row; pairs with no compliance (constrained DOFs) get the largest one.
+Vector row_scales(const ProblemView& p)
+{
+  const int m = p.pairs();
+  double wmax = 0.0;
+  for (Eigen::Index i = 0; i < p.W.rows(); ++i)
+    wmax = std::max(wmax, std::abs(p.W(i, i)));
+  if (!(wmax > 0.0))
+    wmax = 1.0;
+  Vector c(m);
+  for (int k = 0; k < m; ++k)
+  {
+    const double w = p.W(k * p.dim, k * p.dim);
+    c[k] = (w > 1e-12 * wmax) ? w : wmax;
+  }
+  return c;
+}
+
+/// @brief Solves A x = b; falls back from LU to a rank-revealing least-squares solve when
+/// A is (nearly) singular, which happens with a semi-definite W (zero rows of constrained
+/// DOFs, two pairs on one node). Returns false if no finite solution came out.
+bool solve_dense(const Matrix& A, const Vector& b, Vector& x)
+{
+  if (A.rows() == 0)
+  {
+    x.resize(0);
+    return true;
+  }
+  Eigen::PartialPivLU<Matrix> lu(A);
+  if (lu.rcond() > 1e-12)
+  {
+    x = lu.solve(b);
+    if (x.allFinite())
+      return true;
+  }
+  // Minimum-norm least squares: a redundant constraint shares the force, an inconsistent
+  // one leaves a residual that the switching rules and the final residual then see.
+  Eigen::CompleteOrthogonalDecomposition<Matrix> cod;
+  cod.setThreshold(1e-11);
+  cod.compute(A);
+  x = cod.solve(b);
+  return x.allFinite();
+}
+
+/// @brief Tangential part of pair k of v (d − 1 values).
+Eigen::VectorXd tangent(const Vector& v, int k, int d)
+{
+  return v.segment(k * d + 1, d - 1);
+}
+
+/// @brief The discrete part of the iteration: states, and the slip directions that enter
+/// the system (2D signs exactly, 3D directions rounded), for revisit detection.
+std::vector<std::int64_t> state_key(const std::vector<PairState>& states, const Matrix& dir,
+                                    const Eigen::Ref<const Vector>& mu)
+{
+  std::vector<std::int64_t> key;
+  key.reserve(states.size() * 3);
+  for (std::size_t k = 0; k < states.size(); ++k)
+  {
+    key.push_back(static_cast<std::int64_t>(states[k]));
+    // A direction changes the system only for a slipping pair with friction.
+    if (states[k] != PairState::slip || mu[static_cast<Eigen::Index>(k)] == 0.0)
+      continue;
+    for (Eigen::Index j = 0; j < dir.rows(); ++j)
+      key.push_back(static_cast<std::int64_t>(std::llround(dir(j, k) * 1e6)));
+  }
+  return key;
+}
+
+/// @brief Starting slip direction of pair k: the predicted slip u_t if any, else against
+/// the force, else against the load q_t, else the first tangent.
+Eigen::VectorXd initial_direction(const ProblemView& p, const Vector& lambda, const Vector& u,
+                                  int k)
+{
+  const int d = p.dim;
+  for (int source = 0; source < 3; ++source)
+  {
+    Eigen::VectorXd v = source == 0   ? tangent(u, k, d)
+                        : source == 1 ? Eigen::VectorXd(-tangent(lambda, k, d))
+                                      : Eigen::VectorXd(p.q.segment(k * d + 1, d - 1));
+    const double len = v.norm();
+    if (len > 0.0 && std::isfinite(len))
+      return v / len;
+  }
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(d - 1);
+  e[0] = 1.0;
+  return e;
+}
+
+const char* state_name(PairState s)
+{
+  return s == PairState::open ? "open" : s == PairState::stick ? "stick" : "slip";
+}
+} // namespace
+
+SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                             const std::vector<PairState>& states0, const SolverOptions& opt)
+{
+  check_inputs(p, lambda0, states0);
+  const int d = p.dim;
+  const int m = p.pairs();
+  const Eigen::Index n = p.q.size();
+
+  SolveReport rep;
+  rep.solver = "active_set";
+  Vector lambda = lambda0.size() ? Vector(lambda0) : Vector(Vector::Zero(n));
+  Vector u = p.W * lambda + p.q;
+
+  std::vector<PairState> states
+      = states0.empty() ? std::vector<PairState>(m, PairState::stick) : states0;
+  Matrix dir = Matrix::Zero(d - 1, m); // unit slip direction in the pair's tangent plane
+  for (int k = 0; k < m; ++k)
+    dir.col(k) = initial_direction(p, lambda, u, k);
+
+  const Vector c = row_scales(p);
+  // Switching thresholds relative to the problem's scale; a tenth of the requested
+  // tolerance so that what is left unswitched cannot spoil the certificate.
+  const double tau = std::max(0.1 * opt.tolerance, 1e3 * std::numeric_limits<double>::epsilon());
+  Vector rho_q(n);
+  for (int k = 0; k < m; ++k)
+    rho_q.segment(k * d, d) = p.q.segment(k * d, d) / c[k];
+
+  Vector best_lambda = lambda;
+  double best_residual = natural_map_residual(p, lambda);
+
+  std::set<std::vector<std::int64_t>> seen;
+  std::vector<std::int64_t> last_key = state_key(states, dir, p.mu);
+  seen.insert(last_key);
+  double omega = 1.0; // relaxation of the 3D slip-direction update
+
+  Matrix A(n, n);
+  Vector b(n), x(n);
+  while (rep.iterations < opt.max_iterations)
+  {
+    // --- the modified system: each pair's state replaces its rows -------------------
+    for (int k = 0; k < m; ++k)
+    {
+      const int i = k * d;
+      switch (states[k])
+      {
+      case PairState::stick: // u_k = 0: the pair's rows of W λ + q
+        A.middleRows(i, d) = p.W.middleRows(i, d);
+        b.segment(i, d) = -p.q.segment(i, d);
+        break;
+      case PairState::slip: // u_n = 0 and λ_t + μ λ_n s = 0 (friction opposes slip s)
+        A.row(i) = p.W.row(i);
+        b[i] = -p.q[i];
+        A.middleRows(i + 1, d - 1).setZero();
+        for (int j = 1; j < d; ++j)
+        {
+          A(i + j, i + j) = c[k];
+          A(i + j, i) = c[k] * p.mu[k] * dir(j - 1, k);
+          b[i + j] = 0.0;
+        }
+        break;
+      case PairState::open: // λ_k = 0
+        A.middleRows(i, d).setZero();
+        for (int j = 0; j < d; ++j)
+        {
+          A(i + j, i + j) = c[k];
+          b[i + j] = 0.0;
+        }
+        break;
+      }
+    }
+    ++rep.iterations;
+    if (!solve_dense(A, b, x))
+    {
+      if (opt.verbose)
+        std::cerr << "active_set: iteration " << rep.iterations
+                  << ": the modified system gave no finite solution; stopping\n";
+      break;
+    }
+    lambda = x;
+    u = p.W * lambda + p.q; // the unmodified rows: gaps of open pairs, slips of slip pairs
+
+    const double res = natural_map_residual(p, lambda);
+    if (res < best_residual)
+    {
+      best_residual = res;
+      best_lambda = lambda;
+    }
+
+    // --- switching -------------------------------------------------------------------
+    const double fscale = std::max({lambda.cwiseAbs().maxCoeff(), rho_q.cwiseAbs().maxCoeff(), tiny});
+    const double gscale = std::max({u.cwiseAbs().maxCoeff(), p.q.cwiseAbs().maxCoeff(), tiny});
+    const double ftol = tau * fscale, gtol = tau * gscale;
+    int changes = 0;
+    double turn = 0.0; // largest change of a 3D slip direction
+    for (int k = 0; k < m; ++k)
+    {
+      const int i = k * d;
+      const double ln = lambda[i];
+      const Eigen::VectorXd lt = tangent(lambda, k, d), ut = tangent(u, k, d);
+      const PairState old = states[k];
+      switch (old)
+      {
+      case PairState::stick:
+        if (ln < -ftol)
+          states[k] = PairState::open;
+        else if (lt.norm() > p.mu[k] * ln + ftol)
+        {
+          states[k] = PairState::slip;
+          dir.col(k) = -lt / lt.norm(); // the slip opposes the force that broke adhesion
+        }
+        break;
+      case PairState::slip:
+        if (ln < -ftol)
+          states[k] = PairState::open;
+        else if (p.mu[k] == 0.0)
+        {
+          // No friction: the direction does not enter the system; keep it for reporting.
+          if (ut.norm() > gtol)
+            dir.col(k) = ut / ut.norm();
+        }
+        else if (ut.dot(dir.col(k)) < -gtol)
+          states[k] = PairState::stick; // the assumed slip reversed
+        else if (d == 3 && ut.norm() > gtol)
+        {
+          // The seed's explicit method: the next direction is this iterate's slip,
+          // relaxed (omega < 1) once the plain update has been seen to oscillate.
+          Eigen::VectorXd s = omega * ut / ut.norm() + (1.0 - omega) * dir.col(k);
+          if (!(s.norm() > 0.5 * omega))
+            s = ut; // the slip turned round: relaxation would cancel, take it as is
+          s.normalize();
+          turn = std::max(turn, (s - dir.col(k)).norm());
+          dir.col(k) = s;
+        }
+        break;
+      case PairState::open:
+        if (u[i] < -gtol)
+          states[k] = PairState::stick;
+        break;
+      }
+      if (states[k] != old)
+      {
+        ++changes;
+        if (opt.verbose)
+          std::cerr << "active_set: iteration " << rep.iterations << ": pair " << k << " "
+                    << state_name(old) << " -> " << state_name(states[k]) << "\n";
+      }
+    }
+    rep.state_changes += changes;
+    if (opt.verbose)
+      std::cerr << "active_set: iteration " << rep.iterations << ": " << changes
+                << " switches, residual " << res << "\n";
+
+    if (res <= opt.tolerance)
+      break; // certified: nothing left to switch that matters
+    if (changes == 0 && turn <= 1e-14)
+      break; // fixed point of states and directions (uncertified if res > tolerance)
+    auto key = state_key(states, dir, p.mu);
+    const bool same_as_last = (key == last_key);
+    last_key = key;
+    if (changes == 0 && same_as_last)
+      continue; // directions still settling below the key's resolution: not a revisit
+    if (!seen.insert(std::move(key)).second)
+    {
+      if (changes == 0 && omega > 1.0 / 64.0)
+      {
+        // Only 3D directions moved and they came back: the explicit update oscillates
+        // about the answer. Relax it and forget the directions seen so far.
+        omega *= 0.5;
+        seen.clear();
+        seen.insert(state_key(states, dir, p.mu));
+        if (opt.verbose)
+          std::cerr << "active_set: iteration " << rep.iterations
+                    << ": slip directions oscillate; relaxation " << omega << "\n";
+        continue;
+      }
+      rep.cycled = true;
+      if (opt.verbose)
+        std::cerr << "active_set: iteration " << rep.iterations
+                  << ": state vector seen before; the iteration cycles\n";
+      break;
+    }
+  }
+
+  rep.lambda = best_lambda;
+  rep.u = p.W * rep.lambda + p.q;
+  rep.residual = natural_map_residual(p, rep.lambda);
+  rep.states = classify_states(p, rep.lambda, rep.u);
+  rep.converged = rep.residual <= opt.tolerance;
+  return rep;
+}
+} // namespace flexcontact

@@ -1,0 +1,121 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file increment.cpp
+/// @brief The incremental driver (seed eqs. 12–18): friction is path dependent, so each
+/// increment's local problem measures slip from the previous increment's tangential gap.
+
+#include "flexcontact/increment.hpp"
+#include "flexcontact/solvers.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace flexcontact
+{
+namespace
+{
+std::string num(double v)
+{
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+} // namespace
+
+IncrementalSolver::IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions options)
+    : dim_(dim), W_(std::move(W)), mu_(std::move(mu)), options_(std::move(options))
+{
+  const std::string who = "flexcontact: IncrementalSolver: ";
+  if (dim_ != 2 && dim_ != 3)
+    throw std::invalid_argument(who + "dimension is " + std::to_string(dim_)
+                                + "; it must be 2 or 3");
+  const Eigen::Index n = mu_.size() * dim_;
+  if (W_.rows() != W_.cols())
+    throw std::invalid_argument(who + "W is " + std::to_string(W_.rows()) + "x"
+                                + std::to_string(W_.cols()) + "; it must be square");
+  if (W_.rows() != n)
+    throw std::invalid_argument(who + "W has " + std::to_string(W_.rows()) + " rows but "
+                                + std::to_string(mu_.size()) + " pairs in " + std::to_string(dim_)
+                                + "D need " + std::to_string(n));
+  for (Eigen::Index k = 0; k < mu_.size(); ++k)
+    if (!std::isfinite(mu_[k]) || mu_[k] < 0.0)
+      throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
+                                  + " is " + num(mu_[k]) + "; it must be finite and >= 0");
+  for (Eigen::Index j = 0; j < W_.cols(); ++j)
+    for (Eigen::Index i = 0; i < W_.rows(); ++i)
+      if (!std::isfinite(W_(i, j)))
+        throw std::invalid_argument(who + "W(" + std::to_string(i) + ", " + std::to_string(j)
+                                    + ") is " + num(W_(i, j)) + " (pair "
+                                    + std::to_string(i / dim_) + "); W must be finite");
+  if (options_.max_iterations < 1)
+    throw std::invalid_argument(who + "max_iterations is "
+                                + std::to_string(options_.max_iterations)
+                                + "; it must be at least 1");
+  if (!(options_.tolerance > 0.0) || !std::isfinite(options_.tolerance))
+    throw std::invalid_argument(who + "tolerance is " + num(options_.tolerance)
+                                + "; it must be finite and > 0");
+  // Unknown solver names are reported now rather than at the first increment.
+  for (const auto& name : options_.chain)
+  {
+    bool known = false;
+    for (const auto& k : solver_names())
+      known = known || k == name;
+    if (!known)
+      throw std::invalid_argument(who + "unknown solver '" + name + "' in the chain");
+  }
+  // Before the first increment nothing has slipped and nothing touches.
+  x_ = Vector::Zero(n);
+  lambda_ = Vector::Zero(n);
+}
+
+void IncrementalSolver::set_initial_gap(const Eigen::Ref<const Vector>& x0)
+{
+  const std::string who = "flexcontact: IncrementalSolver::set_initial_gap: ";
+  if (x0.size() != x_.size())
+    throw std::invalid_argument(who + "x0 has size " + std::to_string(x0.size())
+                                + ", expected " + std::to_string(x_.size()));
+  for (Eigen::Index i = 0; i < x0.size(); ++i)
+    if (!std::isfinite(x0[i]))
+      throw std::invalid_argument(who + "x0[" + std::to_string(i) + "] (pair "
+                                  + std::to_string(i / dim_) + ") is " + num(x0[i]));
+  x_ = x0;
+}
+
+const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_total)
+{
+  const std::string who = "flexcontact: IncrementalSolver::step: ";
+  if (q_total.size() != W_.rows())
+    throw std::invalid_argument(who + "q has size " + std::to_string(q_total.size())
+                                + ", expected " + std::to_string(W_.rows()));
+  for (Eigen::Index i = 0; i < q_total.size(); ++i)
+    if (!std::isfinite(q_total[i]))
+      throw std::invalid_argument(who + "q[" + std::to_string(i) + "] (pair "
+                                  + std::to_string(i / dim_) + ") is " + num(q_total[i])
+                                  + "; q must be finite");
+
+  // The slip of this increment is x_t − x_t,prev: remove the previous tangential gap.
+  Vector q = q_total;
+  const int m = pairs();
+  for (int k = 0; k < m; ++k)
+    for (int j = 1; j < dim_; ++j)
+      q[k * dim_ + j] -= x_[k * dim_ + j];
+
+  const ProblemView view{dim_, W_, q, mu_};
+  SolveReport r = solve(view, lambda_, states_, options_);
+  if (!r.converged)
+  {
+    std::string what = "flexcontact: increment did not converge; best residual "
+                       + num(r.residual) + " (tolerance " + num(options_.tolerance)
+                       + ") from " + r.solver + ". Tried:";
+    for (const auto& a : r.attempts)
+      what += " [" + a + "]";
+    throw ConvergenceError(what, std::move(r));
+  }
+  x_ = W_ * r.lambda + q_total;
+  lambda_ = r.lambda;
+  states_ = r.states;
+  last_ = std::move(r);
+  return last_;
+}
+} // namespace flexcontact

@@ -1,0 +1,229 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file newton_ac.cpp
+/// @brief Semi-smooth Newton on the Alart–Curnier formulation with a line search.
+
+#include "flexcontact/residual.hpp"
+#include "flexcontact/solvers.hpp"
+
+#include "ac_pair.hpp"
+
+#include <Eigen/LU>
+#include <Eigen/QR>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+namespace flexcontact
+{
+namespace
+{
+/// @brief Φ(λ) for all pairs from λ and u = Wλ + q; optionally the blocks ∂P/∂z (d×d each).
+void ac_all(const ProblemView& p, const Vector& rho, const Vector& rho_t, const Vector& lam,
+            const Vector& u, Vector& phi, std::vector<double>* dP)
+{
+  const int d = p.dim;
+  for (int k = 0; k < p.pairs(); ++k)
+    detail::ac_pair(lam.data() + k * d, u.data() + k * d, p.mu[k], rho[k], rho_t[k], d,
+                    phi.data() + k * d, dP ? dP->data() + k * d * d : nullptr);
+}
+
+/// @brief Solve A x = b, pivoted LU first. A singular A (semi-definite W, fully constrained
+/// pairs) gets the minimum-norm least-squares step instead: it moves nothing along the null
+/// space, where an LU or a small regularisation would send λ off to huge values that the
+/// relative residual then mistakes for convergence. Beyond a size where a rank-revealing
+/// factorisation is too slow, a Tikhonov-regularised LU is the fallback. Returns false if
+/// no finite solution was found.
+bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
+{
+  const double bn = b.norm();
+  {
+    Eigen::PartialPivLU<Matrix> lu(A);
+    x = lu.solve(b);
+    if (x.allFinite() && (A * x - b).norm() <= 1e-8 * std::max(bn, 1e-300))
+      return true;
+  }
+  if (A.rows() <= 1500)
+  {
+    Eigen::CompleteOrthogonalDecomposition<Matrix> cod(A);
+    cod.setThreshold(1e-12);
+    x = cod.compute(A).solve(b);
+    return x.allFinite();
+  }
+  const double scale = std::max(A.cwiseAbs().rowwise().sum().maxCoeff(), 1e-300);
+  Matrix R = A;
+  R.diagonal().array() += 1e-8 * scale;
+  x = Eigen::PartialPivLU<Matrix>(R).solve(b);
+  return x.allFinite();
+}
+} // namespace
+
+SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                            const SolverOptions& opt)
+{
+  detail::check_problem(p, lambda0, "solve_newton_ac");
+  const int d = p.dim;
+  const int m = p.pairs();
+  const int n = m * d;
+  const Vector rho = pair_rho(p);
+  const Vector rho_t = detail::tangential_rho(p, rho);
+
+  SolveReport rep;
+  rep.solver = "newton_ac";
+  Vector lam = lambda0.size() ? Vector(lambda0) : Vector::Zero(n);
+  Vector u = p.W * lam + p.q;
+  Vector phi(n), phi_try(n), lam_try(n), u_try(n), dl(n), Wdl(n);
+  std::vector<double> dP(static_cast<std::size_t>(m) * d * d);
+  std::vector<int> closed;
+  closed.reserve(m);
+
+  ac_all(p, rho, rho_t, lam, u, phi, &dP);
+  double f = 0.5 * phi.squaredNorm();
+  double res = natural_map_residual(p, lam, u, rho);
+  int it = 0;
+  std::string why;
+  int last_gain = 0, sweeps_used = 0;
+  double best = res;
+  // Iterations without halving the residual before Newton is declared stalled.
+  constexpr int stall = 8;
+  // Non-monotone reference: the largest merit of the last few accepted iterates lets the
+  // iteration pass the shallow ridges the kinks of Φ create (Grippo–Lampariello–Lucidi).
+  std::vector<double> history{f};
+  constexpr int memory = 5;
+  constexpr double sigma = 1e-4;
+  while (res > opt.tolerance && it < opt.max_iterations)
+  {
+    ++it;
+    // Newton system J Δ = −Φ, J = I − D (I − ρW) = (I − D) + D ρ W with D = blockdiag(∂P/∂z).
+    // Pairs with D_k = 0 (open) have identity rows: Δ_k = −Φ_k; only the closed block is
+    // factorised, which keeps the dense LU to the size of the contact zone.
+    closed.clear();
+    for (int k = 0; k < m; ++k)
+    {
+      const double* D = dP.data() + k * d * d;
+      bool nz = false;
+      for (int i = 0; i < d * d; ++i)
+        nz = nz || D[i] != 0.0;
+      if (nz)
+        closed.push_back(k);
+    }
+    dl = -phi;
+    const int nc = static_cast<int>(closed.size());
+    if (nc > 0)
+    {
+      // Rows of the closed pairs: (I−D)_kk Δ_k + D_k ρ_k Σ_j W_kj Δ_j = −Φ_k, with Δ_open known.
+      // Since Δ = −Φ on open pairs, W_kj Δ_j for open j moves to the right-hand side; the
+      // full product WΔ₀ (Δ₀ zero on closed pairs) gives it at once.
+      Vector d0 = dl;
+      for (int k : closed)
+        d0.segment(k * d, d).setZero();
+      const Vector Wd0 = p.W * d0;
+      Matrix A(nc * d, nc * d);
+      Vector b(nc * d);
+      for (int a = 0; a < nc; ++a)
+      {
+        const int k = closed[a];
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+            D(dP.data() + k * d * d, d, d);
+        Matrix Dr = D;
+        Dr.col(0) *= rho[k];
+        Dr.rightCols(d - 1) *= rho_t[k];
+        for (int c = 0; c < nc; ++c)
+          A.block(a * d, c * d, d, d).noalias() = Dr * p.W.block(k * d, closed[c] * d, d, d);
+        A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - D;
+        b.segment(a * d, d) = -phi.segment(k * d, d) - Dr * Wd0.segment(k * d, d);
+      }
+      Vector x;
+      if (!linear_solve(A, b, x))
+      {
+        why = ", linear system not solvable";
+        break;
+      }
+      for (int a = 0; a < nc; ++a)
+        dl.segment(closed[a] * d, d) = x.segment(a * d, d);
+    }
+
+    // Line search on ½‖Φ‖², Armijo with a non-monotone reference; if the Newton direction
+    // gives no decrease, the fixed-point direction −Φ (a projected step) is tried.
+    const double fref = *std::max_element(history.begin(), history.end());
+    bool accepted = false;
+    for (int attempt = 0; attempt < 2 && !accepted; ++attempt)
+    {
+      if (attempt == 1)
+        dl = -phi;
+      Wdl.noalias() = p.W * dl;
+      double alpha = 1.0;
+      for (int ls = 0; ls < 40; ++ls, alpha *= 0.5)
+      {
+        lam_try = lam + alpha * dl;
+        u_try = u + alpha * Wdl;
+        ac_all(p, rho, rho_t, lam_try, u_try, phi_try, nullptr);
+        const double ft = 0.5 * phi_try.squaredNorm();
+        if (std::isfinite(ft) && ft <= fref - 2.0 * sigma * alpha * f)
+        {
+          accepted = true;
+          break;
+        }
+      }
+    }
+    if (!accepted || it - last_gain >= stall)
+    {
+      // Stalled: a few Gauss–Seidel sweeps with exact pair solves move λ to where Newton
+      // regains its fast local convergence (they succeed where the kinks of Φ trap Newton).
+      ++sweeps_used;
+      for (int s = 0; s < 5 && res > opt.tolerance; ++s)
+      {
+        detail::nsgs_sweep(p, rho, lam, u);
+        u.noalias() = p.W * lam + p.q;
+        res = natural_map_residual(p, lam, u, rho);
+      }
+      if (!lam.allFinite())
+      {
+        why = ", non-finite iterate";
+        break;
+      }
+      ac_all(p, rho, rho_t, lam, u, phi, &dP);
+      f = 0.5 * phi.squaredNorm();
+      history.assign(1, f);
+      last_gain = it;
+      best = std::min(best, res);
+      if (opt.verbose)
+        std::fprintf(stderr, "newton_ac it %d: Gauss-Seidel sweeps, residual %.3e\n", it, res);
+      continue;
+    }
+    lam.swap(lam_try);
+    // Recompute u now and then: the running update accumulates rounding on long runs.
+    if (it % 20 == 0)
+      u.noalias() = p.W * lam + p.q;
+    else
+      u.swap(u_try);
+    ac_all(p, rho, rho_t, lam, u, phi, &dP);
+    f = 0.5 * phi.squaredNorm();
+    history.push_back(f);
+    if (static_cast<int>(history.size()) > memory)
+      history.erase(history.begin());
+    res = natural_map_residual(p, lam, u, rho);
+    if (res < 0.5 * best)
+    {
+      best = res;
+      last_gain = it;
+    }
+    if (opt.verbose)
+      std::fprintf(stderr, "newton_ac it %d: closed %d, merit %.3e, residual %.3e\n", it, nc, f,
+                   res);
+  }
+
+  rep.iterations = it;
+  rep.lambda = lam;
+  rep.u = p.W * lam + p.q;
+  rep.residual = natural_map_residual(p, rep.lambda);
+  rep.converged = rep.residual <= opt.tolerance;
+  rep.states = classify_states(p, rep.lambda, rep.u);
+  if (sweeps_used > 0)
+    why += ", Gauss-Seidel restarts " + std::to_string(sweeps_used);
+  rep.attempts.push_back("newton_ac: " + std::string(rep.converged ? "converged" : "not converged")
+                         + " in " + std::to_string(it) + " iterations, residual "
+                         + std::to_string(rep.residual) + why);
+  return rep;
+}
+} // namespace flexcontact

@@ -1,0 +1,99 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file solve.cpp
+/// @brief The dispatcher: the solvers of the chain in order, each starting from the best λ
+/// found so far, until one returns a certified answer.
+
+#include "flexcontact/residual.hpp"
+#include "flexcontact/solvers.hpp"
+
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+
+namespace flexcontact
+{
+std::vector<std::string> solver_names() { return {"active_set", "projection", "newton_ac"}; }
+
+std::vector<std::string> default_chain()
+{
+  // Newton converges fast where it converges; the active set is the seed's method and
+  // exact when its states settle; the projection fixed point is slow but hardly ever fails.
+  return {"newton_ac", "active_set", "projection"};
+}
+
+namespace
+{
+/// @brief Throws unless every name of the chain is a known solver.
+void check_chain(const std::vector<std::string>& chain)
+{
+  const auto known = solver_names();
+  for (const auto& name : chain)
+  {
+    bool found = false;
+    for (const auto& k : known)
+      found = found || (k == name);
+    if (!found)
+    {
+      std::string list;
+      for (const auto& k : known)
+        list += (list.empty() ? "" : ", ") + k;
+      throw std::invalid_argument("flexcontact: unknown solver '" + name
+                                  + "' in the chain; known solvers: " + list);
+    }
+  }
+}
+
+/// @brief One line of SolveReport::attempts.
+std::string attempt_line(const SolveReport& r)
+{
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3e", r.residual);
+  std::string line = r.solver + ": " + std::to_string(r.iterations) + " iterations, residual "
+                     + buf;
+  if (r.state_changes > 0)
+    line += ", " + std::to_string(r.state_changes) + " state changes";
+  line += r.converged ? ", converged" : (r.cycled ? ", cycled" : ", not converged");
+  return line;
+}
+} // namespace
+
+SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                  const std::vector<PairState>& states0, const SolverOptions& opt)
+{
+  const std::vector<std::string> chain = opt.chain.empty() ? default_chain() : opt.chain;
+  check_chain(chain);
+
+  std::vector<std::string> attempts;
+  SolveReport best;
+  bool have_best = false;
+  for (const auto& name : chain)
+  {
+    // Later solvers start from the best answer so far: a near-miss of one is a good start
+    // for the next. Only the first attempt takes the caller's states; after that the
+    // states of the best answer describe its λ.
+    const Vector start = have_best ? best.lambda : Vector(lambda0);
+    const std::vector<PairState> states = have_best ? best.states : states0;
+    SolveReport r;
+    if (name == "active_set")
+      r = solve_active_set(p, start, states, opt);
+    else if (name == "projection")
+      r = solve_projection(p, start, opt);
+    else
+      r = solve_newton_ac(p, start, opt);
+    r.solver = name;
+    attempts.push_back(attempt_line(r));
+    if (opt.verbose)
+      std::cerr << "solve: " << attempts.back() << "\n";
+    if (!have_best || r.residual < best.residual || (r.converged && !best.converged))
+    {
+      best = std::move(r);
+      have_best = true;
+    }
+    if (best.converged)
+      break;
+  }
+  best.attempts = std::move(attempts);
+  return best;
+}
+} // namespace flexcontact

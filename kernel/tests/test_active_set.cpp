@@ -1,0 +1,262 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file test_active_set.cpp
+/// @brief The Feng–Touzot active-set method on hand-derived problems, and the dispatcher's
+/// fallback when the plain iteration cycles.
+
+#include "flexcontact/residual.hpp"
+#include "flexcontact/solvers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace flexcontact;
+
+namespace
+{
+Vector vec(std::initializer_list<double> v)
+{
+  Vector x(static_cast<Eigen::Index>(v.size()));
+  Eigen::Index i = 0;
+  for (double a : v)
+    x[i++] = a;
+  return x;
+}
+
+SolverOptions chain_of(std::vector<std::string> names)
+{
+  SolverOptions o;
+  o.chain = std::move(names);
+  return o;
+}
+
+/// @brief A single pair whose plain active set cycles stick → open → stick: the strong
+/// normal–tangential coupling W_nt = 0.8 makes the stick answer pull (λ_n < 0) and the open
+/// answer penetrate (u_n = −1), while the answer is slip. Hand solution, μ = 1/2: slip
+/// against s = −1, λ_t = μ λ_n, normal row λ_n + 0.8 μ λ_n = 1 ⇒ λ = (5/7, 5/14),
+/// u_t = 0.8·5/7 + 5/14 − 2 = −15/14 (along s).
+struct CyclingPair
+{
+  Matrix W = (Matrix(2, 2) << 1.0, 0.8, 0.8, 1.0).finished();
+  Vector q = vec({-1.0, -2.0});
+  Vector mu = vec({0.5});
+};
+} // namespace
+
+TEST(ActiveSet, SpringPressedOntoWall)
+{
+  // Normal spring k, tangential spring k_t, gap g0, imposed approach δ > g0: λ_n = k (δ − g0).
+  const double k = 2e3, kt = 5e2, g0 = 0.01, delta = 0.03;
+  const Matrix W = (Matrix(2, 2) << 1.0 / k, 0.0, 0.0, 1.0 / kt).finished();
+  const Vector q = vec({g0 - delta, 0.0}), mu = vec({0.3});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_NEAR(r.lambda[0], k * (delta - g0), 1e-12 * k * delta);
+  EXPECT_EQ(r.lambda[1], 0.0);
+  EXPECT_NEAR(r.u[0], 0.0, 1e-15);
+  EXPECT_EQ(r.states[0], PairState::stick);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_LE(r.residual, 1e-12);
+  EXPECT_FALSE(r.cycled);
+}
+
+TEST(ActiveSet, SpringNotTouchingWall)
+{
+  const double k = 2e3, kt = 5e2, g0 = 0.01, delta = 0.004;
+  const Matrix W = (Matrix(2, 2) << 1.0 / k, 0.0, 0.0, 1.0 / kt).finished();
+  const Vector q = vec({g0 - delta, 0.0}), mu = vec({0.3});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_EQ(r.lambda.norm(), 0.0);
+  EXPECT_NEAR(r.u[0], g0 - delta, 1e-15);
+  EXPECT_EQ(r.states[0], PairState::open);
+  EXPECT_EQ(r.iterations, 2); // stick pulls → open, then no change
+  EXPECT_EQ(r.state_changes, 1);
+}
+
+TEST(ActiveSet, TwoDimensionalSlipOpposesTheForce)
+{
+  // W = I, q = (−1, −2), μ = 1/2. Stick gives λ = (1, 2), outside the cone; slip with
+  // s = −1: λ = (1, 1/2), u_t = 1/2 − 2 = −3/2 along s.
+  const Matrix W = Matrix::Identity(2, 2);
+  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_NEAR(r.lambda[0], 1.0, 1e-14);
+  EXPECT_NEAR(r.lambda[1], 0.5, 1e-14);
+  EXPECT_NEAR(r.u[1], -1.5, 1e-14);
+  EXPECT_EQ(r.states[0], PairState::slip);
+}
+
+TEST(ActiveSet, ThreeDimensionalSlipAlongTheLoad)
+{
+  // W = I, q = (−1, −3, −4), μ = 1/2: λ_n = 1, λ_t = μ λ_n (3, 4)/5 = (0.3, 0.4),
+  // u_t = λ_t + q_t = −4.5 (0.6, 0.8).
+  const Matrix W = Matrix::Identity(3, 3);
+  const Vector q = vec({-1.0, -3.0, -4.0}), mu = vec({0.5});
+  const ProblemView p{3, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_LT((r.lambda - vec({1.0, 0.3, 0.4})).norm(), 1e-14);
+  EXPECT_LT((r.u - vec({0.0, -2.7, -3.6})).norm(), 1e-14);
+  EXPECT_EQ(r.states[0], PairState::slip);
+}
+
+TEST(ActiveSet, ThreeDimensionalSlipDirectionFoundIteratively)
+{
+  // Anisotropic tangential compliance turns the slip away from the load, so the explicit
+  // method must iterate on the direction. W_nt = 0 fixes λ_n = 1 and |λ_t| = μ = 0.3.
+  const Matrix W = (Matrix(3, 3) << 1.0, 0.0, 0.0, 0.0, 2.0, 0.5, 0.0, 0.5, 1.0).finished();
+  const Vector q = vec({-1.0, -3.0, -1.0}), mu = vec({0.3});
+  const ProblemView p{3, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual << " after " << r.iterations;
+  EXPECT_GT(r.iterations, 2);
+  EXPECT_NEAR(r.lambda[0], 1.0, 1e-9);
+  const Eigen::Vector2d lt = r.lambda.tail(2), ut = r.u.tail(2);
+  EXPECT_NEAR(lt.norm(), 0.3, 1e-9);
+  EXPECT_NEAR(lt.dot(ut) / (lt.norm() * ut.norm()), -1.0, 1e-9); // friction opposes slip
+  EXPECT_NEAR(r.u[0], 0.0, 1e-9);
+}
+
+TEST(ActiveSet, TwoPairsOneOpens)
+{
+  // Normal rows coupled: W_nn = [[2, 1], [1, 2]], q_n = (−1, 1); tangential W_tt = I,
+  // q_t0 = −0.1. Both stick: λ_n = (1, −1), so pair 1 pulls and opens. Then pair 0 alone:
+  // λ_n0 = 1/2, λ_t0 = 0.1 (inside the cone, μ = 1/2), and the open pair's gap is
+  // u_n1 = 1·(1/2) + 1 = 3/2 > 0.
+  Matrix W = Matrix::Zero(4, 4);
+  W(0, 0) = 2.0, W(0, 2) = 1.0, W(2, 0) = 1.0, W(2, 2) = 2.0, W(1, 1) = 1.0, W(3, 3) = 1.0;
+  const Vector q = vec({-1.0, -0.1, 1.0, 0.0}), mu = vec({0.5, 0.5});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_LT((r.lambda - vec({0.5, 0.1, 0.0, 0.0})).norm(), 1e-14);
+  EXPECT_LT((r.u - vec({0.0, 0.0, 1.5, 0.0})).norm(), 1e-14);
+  EXPECT_EQ(r.states, (std::vector<PairState>{PairState::stick, PairState::open}));
+  EXPECT_EQ(r.iterations, 2);
+  EXPECT_EQ(r.state_changes, 1);
+}
+
+TEST(ActiveSet, FrictionlessPairSlipsFreely)
+{
+  const Matrix W = Matrix::Identity(2, 2);
+  const Vector q = vec({-1.0, -2.0}), mu = vec({0.0});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_LT((r.lambda - vec({1.0, 0.0})).norm(), 1e-14);
+  EXPECT_EQ(r.states[0], PairState::slip);
+}
+
+TEST(ActiveSet, SemidefiniteWGivesFiniteAnswers)
+{
+  // Two pairs on one node: identical rows, W singular. Stick solves a consistent singular
+  // system; any split of λ_n0 + λ_n1 = 1 is a solution.
+  Matrix W(4, 4);
+  W << 1, 0, 1, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0, 1, 0, 1;
+  const Vector q = vec({-1.0, 0.0, -1.0, 0.0}), mu = vec({0.4, 0.4});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.lambda.allFinite());
+  EXPECT_TRUE(r.converged) << r.residual;
+  EXPECT_NEAR(r.lambda[0] + r.lambda[2], 1.0, 1e-12);
+
+  // A pair on constrained DOFs: zero rows and columns. It cannot close; with a positive gap
+  // it must come out open with λ = 0, and the other pair is unaffected.
+  Matrix W2 = Matrix::Zero(4, 4);
+  W2(0, 0) = 1.0, W2(1, 1) = 1.0;
+  const Vector q2 = vec({-1.0, 0.0, 0.5, 0.0});
+  const ProblemView p2{2, W2, q2, mu};
+  const SolveReport r2 = solve_active_set(p2, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r2.lambda.allFinite());
+  EXPECT_TRUE(r2.converged) << r2.residual;
+  EXPECT_LT((r2.lambda - vec({1.0, 0.0, 0.0, 0.0})).norm(), 1e-14);
+  EXPECT_EQ(r2.states[1], PairState::open);
+}
+
+TEST(ActiveSet, StartsFromGivenStates)
+{
+  // Starting in the answer's states, one solve confirms it.
+  const Matrix W = Matrix::Identity(2, 2);
+  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r
+      = solve_active_set(p, vec({1.0, 0.5}), {PairState::slip}, SolverOptions{});
+  ASSERT_TRUE(r.converged);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_EQ(r.state_changes, 0);
+}
+
+TEST(ActiveSet, RejectsInconsistentInputs)
+{
+  const Matrix W = Matrix::Identity(2, 2);
+  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
+  const ProblemView p{2, W, q, mu};
+  EXPECT_THROW(solve_active_set(p, vec({1.0}), {}, SolverOptions{}), std::invalid_argument);
+  EXPECT_THROW(solve_active_set(p, Vector(), {PairState::stick, PairState::stick},
+                                SolverOptions{}),
+               std::invalid_argument);
+}
+
+TEST(ActiveSet, PlainIterationCyclesOnStrongCoupling)
+{
+  const CyclingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  // Stick: λ = −W⁻¹ q = (−5/3, 10/3) pulls → open; open: u_n = −1 → stick again.
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  EXPECT_TRUE(r.cycled);
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.iterations, 2);
+  EXPECT_TRUE(r.lambda.allFinite());
+  EXPECT_GT(r.residual, 1e-3);
+}
+
+TEST(Dispatcher, FallsBackWhenTheActiveSetCycles)
+{
+  const CyclingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve(p, Vector(), {}, chain_of({"active_set", "newton_ac"}));
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_EQ(r.solver, "newton_ac");
+  ASSERT_EQ(r.attempts.size(), 2u);
+  EXPECT_NE(r.attempts[0].find("active_set"), std::string::npos);
+  EXPECT_NE(r.attempts[0].find("cycled"), std::string::npos);
+  EXPECT_NE(r.attempts[1].find("converged"), std::string::npos);
+  EXPECT_LE(r.residual, 1e-10);
+  EXPECT_LE(natural_map_residual(p, r.lambda), 1e-10); // certified independently
+  EXPECT_NEAR(r.lambda[0], 5.0 / 7.0, 1e-9);
+  EXPECT_NEAR(r.lambda[1], 5.0 / 14.0, 1e-9);
+  EXPECT_NEAR(r.u[1], -15.0 / 14.0, 1e-9);
+  EXPECT_EQ(r.states[0], PairState::slip);
+}
+
+TEST(Dispatcher, DefaultChainAndNames)
+{
+  EXPECT_EQ(default_chain(), (std::vector<std::string>{"newton_ac", "active_set", "projection"}));
+  const auto names = solver_names();
+  for (const auto& n : default_chain())
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+  const CyclingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve(p, Vector(), {}, SolverOptions{});
+  EXPECT_TRUE(r.converged);
+  EXPECT_GE(r.attempts.size(), 1u);
+  EXPECT_THROW(solve(p, Vector(), {}, chain_of({"simplex"})), std::invalid_argument);
+}
+
+TEST(Dispatcher, StopsAtTheFirstSolverThatConverges)
+{
+  const Matrix W = Matrix::Identity(2, 2);
+  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
+  const ProblemView p{2, W, q, mu};
+  const SolveReport r = solve(p, Vector(), {}, chain_of({"active_set", "newton_ac"}));
+  ASSERT_TRUE(r.converged);
+  EXPECT_EQ(r.solver, "active_set");
+  EXPECT_EQ(r.attempts.size(), 1u);
+}

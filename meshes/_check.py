@@ -1,0 +1,25 @@
+"""Parameter checks with messages that name the parameter and its value."""
+
+import math
+import numbers
+
+
+def positive(name: str, value, unit: str = "m") -> float:
+    """``value`` as float if it is a finite number > 0, else ValueError."""
+    if not (isinstance(value, numbers.Real) and not isinstance(value, bool)
+            and math.isfinite(value) and value > 0):
+        raise ValueError(f"{name}={value!r}: must be a finite number > 0 ({unit})")
+    return float(value)
+
+
+def refine_level(value) -> int:
+    """``refine`` as int if it is an integer >= 0, else ValueError."""
+    if not (isinstance(value, numbers.Integral) and not isinstance(value, bool) and value >= 0):
+        raise ValueError(f"refine={value!r}: must be an integer >= 0")
+    return int(value)
+
+
+def less(name: str, value: float, bound_name: str, bound: float):
+    """ValueError unless value < bound."""
+    if not value < bound:
+        raise ValueError(f"{name}={value!r} must be < {bound_name}={bound!r}")

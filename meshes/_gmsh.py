@@ -1,0 +1,122 @@
+"""The one place that talks to both gmsh and DOLFINx's gmsh reader.
+
+A builder calls :func:`generate` with a function that, on rank 0 only, adds geometry,
+physical groups and the mesh to the current gmsh model. The mesh is then distributed to
+every rank of ``comm``. Errors raised while building are re-raised on every rank, so a bad
+parameter cannot leave the other ranks waiting in a broadcast.
+"""
+
+import gmsh
+import dolfinx.io.gmshio as gmshio  # the submodule must be imported explicitly in 0.5
+
+_owned = False  # True while gmsh was initialised by this module (so we finalise it)
+
+
+def _is_initialized() -> bool:
+    """Whether gmsh is initialised. gmsh 4.8 cannot tell (its API answers even before
+    ``initialize``), so there only this module's own sessions are known: a session the
+    caller opened is then finalised too, after the mesh was read."""
+    probe = getattr(gmsh, "isInitialized", None)  # gmsh >= 4.11
+    return bool(probe()) if probe is not None else _owned
+
+
+def start(name: str):
+    """Initialise gmsh (unless the caller already did) and add an empty model ``name``."""
+    global _owned
+    if not _is_initialized():
+        gmsh.initialize(readConfigFiles=False)
+        _owned = True
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("General.Verbosity", 2)
+    # Coincident points of the two bodies must stay distinct entities: node–node contact
+    # needs separate nodes on each side of the interface.
+    gmsh.option.setNumber("Geometry.AutoCoherence", 0)
+    gmsh.model.add(name)
+
+
+def stop():
+    """Remove the current model; finalise gmsh if this module initialised it."""
+    global _owned
+    if _is_initialized() or _owned:
+        gmsh.model.remove()
+        if _owned:
+            gmsh.finalize()
+            _owned = False
+
+
+def to_dolfinx(comm, gdim: int):
+    """Distribute the current gmsh model (living on rank 0) as a DOLFINx mesh.
+
+    Returns ``(mesh, cell_tags, facet_tags)``. Must be called on every rank of ``comm``;
+    finalises gmsh on rank 0 afterwards. Only elements in physical groups are kept.
+    """
+    try:
+        # DOLFINx 0.5–0.9 spelling; later versions return a MeshData tuple-like object.
+        out = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=gdim)
+        msh, cell_tags, facet_tags = out[0], out[1], out[2]
+    finally:
+        if comm.rank == 0:
+            stop()
+    return msh, cell_tags, facet_tags
+
+
+def generate(comm, name: str, build_model, gdim: int):
+    """Run ``build_model()`` on rank 0 inside a fresh gmsh model, then :func:`to_dolfinx`.
+
+    ``build_model`` returns a picklable dict of geometry parameters, which is broadcast and
+    returned as the fourth item: ``(mesh, cell_tags, facet_tags, info)``.
+    """
+    info, error = None, None
+    if comm.rank == 0:
+        try:
+            start(name)
+            info = build_model()
+        except Exception as exc:  # re-raised on every rank below
+            error = exc
+            stop()
+    error = comm.bcast(error, root=0)
+    if error is not None:
+        raise error
+    info = comm.bcast(info, root=0)
+    msh, cell_tags, facet_tags = to_dolfinx(comm, gdim)
+    return msh, cell_tags, facet_tags, info
+
+
+def physical(dim: int, entities, tag: int, name: str):
+    """Add a named physical group of ``dim``-entities with number ``tag``."""
+    gmsh.model.addPhysicalGroup(dim, list(entities), tag)
+    gmsh.model.setPhysicalName(dim, tag, name)
+
+
+def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float,
+               dist_far: float, points_per_curve: int = 20, boxes=()):
+    """Background mesh size (m): h_near within dist_near of the ``dim``-entities (curves or
+    surfaces), growing linearly to h_far at dist_far. ``boxes``: extra caps
+    ``(size, x0, y0, z0, x1, y1, z1)``; inside such a box the size never exceeds ``size``.
+    Sizes from points and curvature are switched off."""
+    field = gmsh.model.mesh.field
+    f_dist = field.add("Distance")
+    field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[dim], list(entities))  # 4.8 names
+    field.setNumber(f_dist, "NumPointsPerCurve", points_per_curve)
+    f_thr = field.add("Threshold")
+    field.setNumber(f_thr, "InField", f_dist)
+    field.setNumber(f_thr, "SizeMin", h_near)
+    field.setNumber(f_thr, "SizeMax", h_far)
+    field.setNumber(f_thr, "DistMin", dist_near)
+    field.setNumber(f_thr, "DistMax", dist_far)
+    fields = [f_thr]
+    for size, *box in boxes:
+        f_box = field.add("Box")
+        for key, val in zip(("XMin", "YMin", "ZMin", "XMax", "YMax", "ZMax"), box):
+            field.setNumber(f_box, key, val)
+        field.setNumber(f_box, "VIn", size)
+        field.setNumber(f_box, "VOut", h_far)
+        fields.append(f_box)
+    if len(fields) > 1:
+        f_min = field.add("Min")
+        field.setNumbers(f_min, "FieldsList", fields)
+        fields = [f_min]
+    field.setAsBackgroundMesh(fields[0])
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)

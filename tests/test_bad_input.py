@@ -1,0 +1,98 @@
+"""Bad input gets an exception that names the problem, and nothing half-written."""
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+
+import flexcontact as fc
+from flexcontact import compat, forms
+from flexcontact.meshes import block_on_base, tags
+
+STEEL = forms.Material(E_Pa=200e9, nu=0.3, name="steel")
+
+
+@pytest.fixture(scope="module")
+def setup():
+    msh, cells, facets, geo = block_on_base.build(MPI.COMM_WORLD)
+    V = compat.vector_space(msh)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
+    a = forms.elasticity_form(u, v, {tags.BASE: STEEL, tags.UPPER: STEEL}, dx, "plane_strain")
+    return msh, cells, facets, V, a, geo
+
+
+def _problem(setup, slave=tags.SLAVE, master=tags.MASTER, mu=0.3, bcs=None, **kw):
+    msh, cells, facets, V, a, geo = setup
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    top, consts = fc.dirichlet(V, facets, tags.LOADED)
+    bcs = fixed + top if bcs is None else bcs
+    p = fc.ContactProblem(a, None, bcs, fc.ContactInterface(facets, slave, master, mu),
+                          bodies=(cells, {"base": tags.BASE, "block": tags.UPPER}), **kw)
+    return p, consts
+
+
+def test_tag_value_absent(setup):
+    with pytest.raises(ValueError, match="99"):
+        _problem(setup, slave=99)
+
+
+def test_surfaces_with_different_node_counts(setup):
+    # The base's bottom has other nodes than the block's bottom.
+    with pytest.raises(ValueError, match="nodes"):
+        _problem(setup, master=tags.FIXED)
+
+
+@pytest.mark.parametrize("mu", [-0.1, math.nan, math.inf])
+def test_bad_friction_coefficient(setup, mu):
+    with pytest.raises(ValueError, match="friction coefficient"):
+        fc.ContactInterface(setup[2], tags.SLAVE, tags.MASTER, mu)
+
+
+def test_body_with_rigid_modes_is_named(setup):
+    msh, cells, facets, V, a, geo = setup
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    # The block's top held only vertically: it can still slide along x.
+    top_y, _ = fc.dirichlet(V, facets, tags.LOADED, components=[1])
+    with pytest.raises(ValueError, match=r"body 'block'.*translation along x"):
+        _problem(setup, bcs=fixed + top_y)
+    with pytest.raises(ValueError, match=r"body 'block'"):
+        _problem(setup, bcs=fixed)
+
+
+def test_non_finite_load_keeps_finished_increments(setup, tmp_path):
+    msh = setup[0]
+    problem, (ux, uy) = _problem(setup)
+    values = [-1e-6, -2e-6, math.nan]
+
+    def load(i, t):
+        uy.value = values[i - 1]
+
+    with pytest.raises(ValueError, match="not finite"):
+        with fc.ResultWriter(tmp_path, "out", msh) as w:
+            problem.solve(3, load=load, writer=w, verbose=False)
+    assert len(problem.increments) == 2
+    # The XDMF written so far is complete and holds the two finished increments.
+    grid = ET.parse(tmp_path / "out.xdmf").getroot()
+    times = {t.get("Value") for t in grid.iter("Time")}
+    assert times == {"1", "2"}
+
+
+def test_not_converging_is_reported(setup):
+    opts = fc.SolverOptions()
+    opts.chain = ["projection"]
+    opts.max_iterations = 1
+    opts.tolerance = 1e-14
+    problem, (ux, uy) = _problem(setup, solver=opts)
+    uy.value = -1e-6
+    with pytest.raises(fc.ConvergenceError, match=r"(?s)projection.*residual"):
+        problem.step()
+    assert problem.increments == []
+
+
+def test_bad_increment_count(setup):
+    problem, _ = _problem(setup)
+    with pytest.raises(ValueError, match="increments"):
+        problem.solve(0)

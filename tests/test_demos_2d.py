@@ -1,0 +1,65 @@
+"""The three 2D demos against their analytic answers (issue: static 2D foundation).
+
+Tolerances are the project's acceptance targets: Hertz a and p0 within 5 %, slip onset within
+1 % of μN, Cattaneo–Mindlin stick zone within 10 %, penetration ≤ 1e-8 of the largest
+displacement, stick pairs without incremental slip, MPI equal to serial to 1e-10.
+"""
+import numpy as np
+import pytest
+
+from demo_runner import run_demo
+
+HERTZ_REFINE = 2  # finest test mesh: contact elements a/40
+
+
+@pytest.fixture(scope="module")
+def hertz(tmp_path_factory):
+    return run_demo("hertz2d", "--refine", HERTZ_REFINE, results=tmp_path_factory.mktemp("h"))
+
+
+def test_hertz_half_width_and_peak_pressure(hertz):
+    s, folder = hertz
+    assert abs(s["a"] / s["a_ref"] - 1) < 0.05, s
+    assert abs(s["p0"] / s["p0_ref"] - 1) < 0.05, s
+    # The whole profile, not only its two numbers: RMS deviation inside the contact.
+    assert s["pressure_rms_error_rel_p0"] < 0.05
+    assert s["max_penetration_rel"] <= 1e-8
+    assert (folder / "hertz2d.xdmf").exists() and (folder / "hertz2d.h5").exists()
+    assert (folder / "hertz2d.png").stat().st_size > 10_000
+
+
+def test_hertz_contact_inside_candidate_zone(hertz):
+    s, _ = hertz
+    state = np.array(s["profile"]["state"])
+    assert state[0] == 0 and state[-1] == 0, "contact reached the edge of the candidate zone"
+
+
+@pytest.mark.mpi
+def test_hertz_mpi_equals_serial(hertz, tmp_path):
+    serial, _ = hertz
+    par, _ = run_demo("hertz2d", "--refine", HERTZ_REFINE, "--no-plot", results=tmp_path, ranks=2)
+    for key in ("P", "a", "p0"):
+        assert par[key] == pytest.approx(serial[key], rel=1e-10, abs=0), key
+    p_s = np.array(serial["profile"]["pressure"])
+    p_p = np.array(par["profile"]["pressure"])
+    assert np.max(np.abs(p_s - p_p)) <= 1e-10 * np.max(np.abs(p_s))
+
+
+def test_sliding_block_slip_onset(tmp_path):
+    s, folder = run_demo("sliding_block", "--refine", 1, results=tmp_path)
+    assert abs(s["slip_onset_T"] / s["slip_onset_T_ref"] - 1) < 0.01, s
+    # Coulomb: the total tangential reaction never exceeds μN (to the solver's tolerance).
+    assert s["max_T_over_muN"] <= 1 + 1e-8
+    assert s["max_stick_slip_increment_rel"] <= 1e-8
+    assert s["max_penetration_rel"] <= 1e-8
+    # Before gross slip the block must really have stuck: T grew through several increments.
+    assert s["slip_onset_increment"] >= 4
+    assert (folder / "sliding_block.png").exists() and (folder / "sliding_block.xdmf").exists()
+
+
+def test_cattaneo_mindlin_stick_zone(tmp_path):
+    s, folder = run_demo("cattaneo_mindlin", "--refine", HERTZ_REFINE, results=tmp_path)
+    assert 0.2 < s["Q_over_muP"] < 0.9, s
+    assert abs(s["c"] / s["c_ref"] - 1) < 0.10, s
+    assert s["stick_pairs"] > 0 and s["slip_pairs"] > 0
+    assert (folder / "cattaneo_mindlin.png").exists()

@@ -1,0 +1,218 @@
+"""Flexibility F* = (K^-1)_cc from one MUMPS factorization (dolfinx_ext/src/flexibility.cpp).
+
+Checked against a dense inverse of K on small meshes, the Schur path against the
+multi-right-hand-side path, the returned factor against a dense solve, singular stiffness
+and bad input as Python exceptions, and serial against `mpirun -n 2`.
+Run as a script (under mpirun) it writes F* of both methods to the file given.
+"""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+import dolfinx.fem.petsc
+import dolfinx.mesh
+
+try:
+    import flexcontact._cpp as fc
+except ImportError:
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "dolfinx_ext" / "python"))
+    import flexcontact._cpp as fc
+
+TOP, RIGHT = 3, 5
+
+
+def elasticity(n, dim, clamped=True, E=1.0e3, nu=0.3):
+    """Unit square/cube, P1 elasticity K (bottom clamped unless told), top/right facet tags."""
+    comm = MPI.COMM_WORLD
+    if dim == 2:
+        msh = dolfinx.mesh.create_rectangle(comm, [np.zeros(2), np.ones(2)], [n, n],
+                                            dolfinx.mesh.CellType.triangle)
+    else:
+        msh = dolfinx.mesh.create_box(comm, [np.zeros(3), np.ones(3)], [n, n, n],
+                                      dolfinx.mesh.CellType.tetrahedron)
+    V = dolfinx.fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+
+    def eps(w):
+        return ufl.sym(ufl.grad(w))
+
+    a = dolfinx.fem.form(ufl.inner(2 * mu * eps(u) + lmbda * ufl.tr(eps(u)) * ufl.Identity(dim),
+                                   eps(v)) * ufl.dx)
+    fdim = dim - 1
+    bcs = []
+    if clamped:
+        bottom = dolfinx.mesh.locate_entities_boundary(msh, fdim, lambda x: np.isclose(x[1], 0.0))
+        dofs = dolfinx.fem.locate_dofs_topological(V, fdim, bottom)
+        bcs = [dolfinx.fem.dirichletbc(np.zeros(dim, dtype=PETSc.ScalarType), dofs, V)]
+    K = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)
+    K.assemble()
+    msh.topology.create_connectivity(fdim, dim)
+    top = dolfinx.mesh.locate_entities_boundary(msh, fdim, lambda x: np.isclose(x[1], 1.0))
+    right = dolfinx.mesh.locate_entities_boundary(
+        msh, fdim, lambda x: np.isclose(x[0], 1.0) & (x[1] < 1.0 - 1e-12))
+    idx = np.concatenate([top, right]).astype(np.int32)
+    val = np.concatenate([np.full(top.size, TOP), np.full(right.size, RIGHT)]).astype(np.int32)
+    order = np.argsort(idx)
+    tags = dolfinx.mesh.meshtags(msh, fdim, idx[order], val[order])
+    return msh, V, K, tags
+
+
+def dense(K):
+    """K as a dense array on every rank."""
+    comm = K.getComm().tompi4py()
+    r0, r1 = K.getOwnershipRange()
+    loc = np.zeros((r1 - r0, K.getSize()[1]))
+    for i in range(r0, r1):
+        cols, vals = K.getRow(i)
+        loc[i - r0, cols] = vals
+    return np.vstack(comm.allgather(loc))
+
+
+def contact_dofs(V, tags, value=TOP):
+    s = fc.surface_nodes(V, tags, value)
+    root = V.mesh.comm.rank == 0
+    return s, (s["dofs"].reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
+
+
+def rel(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+@pytest.mark.parametrize("dim,n", [(2, 6), (3, 3)])
+@pytest.mark.parametrize("method", ["schur", "matmatsolve"])
+def test_flexibility_equals_dense_inverse_block(dim, n, method):
+    msh, V, K, tags = elasticity(n, dim)
+    s, dofs = contact_dofs(V, tags)
+    F, factor, info = fc.flexibility(K, dofs, method)
+    Kd = dense(K)
+    Fd = np.linalg.inv(Kd)[np.ix_(dofs, dofs)]
+    assert F.shape == (dofs.size, dofs.size)
+    assert rel(F, Fd) < 1e-10
+    assert np.allclose(F, F.T, rtol=0, atol=1e-14 * np.abs(F).max())
+    assert info["method"] == method
+    assert info["n_contact_dofs"] == dofs.size == (n + 1) ** (dim - 1) * dim
+    assert info["null_pivots"] == 0
+    assert info["factorizations"] == 1
+    for key in ("factorization_s", "schur_s", "inverse_s"):
+        assert info[key] >= 0.0
+
+
+def test_schur_matches_matmatsolve():
+    msh, V, K, tags = elasticity(12, 2)
+    _, dofs = contact_dofs(V, tags)
+    Fs, _, _ = fc.flexibility(K, dofs, "schur")
+    Fm, _, _ = fc.flexibility(K, dofs, "matmatsolve")
+    assert rel(Fs, Fm) < 1e-10
+
+
+def test_contact_dof_order_is_kept():
+    msh, V, K, tags = elasticity(5, 2)
+    _, dofs = contact_dofs(V, tags)
+    perm = np.random.default_rng(1).permutation(dofs.size)
+    F, _, _ = fc.flexibility(K, dofs, "schur")
+    Fp, _, _ = fc.flexibility(K, dofs[perm], "schur")
+    assert rel(Fp, F[np.ix_(perm, perm)]) < 1e-12
+
+
+@pytest.mark.parametrize("method", ["schur", "matmatsolve"])
+def test_factor_solves_with_K(method):
+    """The returned factor (in serial the Schur-enabled one) still gives x = K^-1 b exactly."""
+    msh, V, K, tags = elasticity(6, 2)
+    _, dofs = contact_dofs(V, tags)
+    _, factor, _ = fc.flexibility(K, dofs, method)
+    b = K.createVecLeft()
+    b.setArray(np.random.default_rng(0).standard_normal(b.getLocalSize()))
+    x = K.createVecRight()
+    factor.solve(b, x)
+    x_ref = np.linalg.solve(dense(K), b.getArray())
+    assert rel(x.getArray(), x_ref) < 1e-10
+
+
+@pytest.mark.parametrize("method", ["schur", "matmatsolve"])
+def test_singular_stiffness_raises(method):
+    msh, V, K, tags = elasticity(4, 2, clamped=False)
+    _, dofs = contact_dofs(V, tags)
+    with pytest.raises(RuntimeError, match="stiffness matrix is singular"):
+        fc.flexibility(K, dofs, method)
+    assert issubclass(fc.SingularStiffnessError, RuntimeError)
+
+
+def test_bad_arguments_raise_value_error():
+    msh, V, K, tags = elasticity(3, 2)
+    with pytest.raises(ValueError, match="unknown flexibility method"):
+        fc.flexibility(K, np.array([0], np.int64), "lu")
+    with pytest.raises(ValueError, match="out of range"):
+        fc.flexibility(K, np.array([K.getSize()[0]], np.int64))
+    with pytest.raises(ValueError, match="listed twice"):
+        fc.flexibility(K, np.array([1, 1], np.int64))
+
+
+def test_petsc_error_becomes_exception():
+    A = PETSc.Mat().createAIJ([4, 4], comm=MPI.COMM_WORLD)
+    A.setUp()  # never assembled
+    with pytest.raises(RuntimeError, match="unassembled"):
+        fc.flexibility(A, np.array([0], np.int64))
+
+
+# ---- serial against two ranks -----------------------------------------------------------
+def _write_flexibility(path):
+    """Under mpirun: F* (both methods) and contact node coordinates on rank 0."""
+    comm = MPI.COMM_WORLD
+    out = {}
+    for dim, n in [(2, 6), (3, 3)]:
+        msh, V, K, tags = elasticity(n, dim)
+        s, dofs = contact_dofs(V, tags)
+        for method in ("schur", "matmatsolve"):
+            F, factor, info = fc.flexibility(K, dofs, method)
+            out[f"{method}_{dim}"] = F
+            if method == "schur":
+                assert info["factorizations"] == (1 if comm.size == 1 else 2)
+            # the returned factor solves with K in parallel too
+            b = K.createVecLeft()
+            b.set(1.0)
+            x, r = K.createVecRight(), K.createVecLeft()
+            factor.solve(b, x)
+            K.mult(x, r)
+            r.axpy(-1.0, b)
+            out[f"{method}_{dim}_residual"] = np.array(r.norm() / b.norm())
+        out[f"x_{dim}"] = s["x"]
+    if comm.rank == 0:
+        np.savez(path, **out)
+
+
+@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
+def test_two_ranks_match_serial(tmp_path):
+    if MPI.COMM_WORLD.size > 1:
+        pytest.skip("runs its own mpirun")
+    path = tmp_path / "flex2.npz"
+    cmd = ["mpirun", "-n", "2", "--oversubscribe"]
+    if os.geteuid() == 0:
+        cmd.append("--allow-run-as-root")
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
+    subprocess.run(cmd + ["/usr/bin/python3", __file__, str(path)], check=True, env=env,
+                   timeout=600, capture_output=True)
+    par = np.load(path)
+    for dim, n in [(2, 6), (3, 3)]:
+        msh, V, K, tags = elasticity(n, dim)
+        s, dofs = contact_dofs(V, tags)
+        # Nodes come sorted by coordinates, so the orders agree whatever the partition.
+        assert np.array_equal(par[f"x_{dim}"], s["x"])
+        for method in ("schur", "matmatsolve"):
+            F, _, _ = fc.flexibility(K, dofs, method)
+            assert rel(par[f"{method}_{dim}"], F) < 1e-10
+            assert float(par[f"{method}_{dim}_residual"]) < 1e-10
+
+
+if __name__ == "__main__":
+    _write_flexibility(sys.argv[1])
