@@ -11,7 +11,6 @@
 #include "surface_nodes.h"
 #include "writeback.h"
 
-#include <dolfinx/wrappers/caster_mpi.h>
 #include <dolfinx/wrappers/caster_petsc.h>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>

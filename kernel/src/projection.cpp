@@ -243,10 +243,16 @@ int detail::nsgs_sweep(const ProblemView& p, const Vector& rho, Vector& lam, Vec
       project_on_cone(lnew.data(), d, p.mu[k]);
     }
     delta = lnew - l;
-    if (delta.head(d).squaredNorm() > 0.0)
+    if (delta.squaredNorm() > 0.0)
     {
-      lam.segment(o, d) = lnew.head(d);
-      u.noalias() += p.W.middleCols(o, d) * delta.head(d);
+      // Column by column: a dynamic-size view of the fixed 3-vector trips GCC 12's
+      // -Warray-bounds inside Eigen's vectorised product.
+      for (int i = 0; i < d; ++i)
+      {
+        lam[o + i] = lnew[i];
+        if (delta[i] != 0.0)
+          u += delta[i] * p.W.col(o + i);
+      }
     }
   }
   return fallbacks;

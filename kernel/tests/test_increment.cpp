@@ -180,3 +180,28 @@ TEST(Increment, FailedIncrementLeavesHistoryUnchanged)
   EXPECT_NEAR(robust.force()[0], 5.0 / 7.0, 1e-9);
   EXPECT_NEAR(robust.force()[1], 5.0 / 14.0, 1e-9);
 }
+
+// An initial tangential offset of a pair is geometry, not slip: with the initial gap set,
+// a stick pair keeps it and the first increment shows no slip.
+TEST(Increment, InitialGapIsNotSlip)
+{
+  using namespace flexcontact;
+  Matrix W(2, 2);
+  W << 1.0, 0.0, 0.0, 1.0;
+  Vector mu(1);
+  mu << 0.5;
+  IncrementalSolver s(2, W, mu);
+  Vector x0(2);
+  x0 << 0.0, 0.3; // touching, tangential offset 0.3
+  s.set_initial_gap(x0);
+  Vector q(2);
+  q << -1.0, 0.3; // pressed by 1, no tangential load
+  const SolveReport& r = s.step(q);
+  ASSERT_TRUE(r.converged);
+  EXPECT_NEAR(r.lambda[0], 1.0, 1e-12);
+  EXPECT_NEAR(r.lambda[1], 0.0, 1e-12);
+  EXPECT_EQ(r.states[0], PairState::stick);
+  EXPECT_NEAR(s.gap()[1], 0.3, 1e-12);
+  Vector bad(3);
+  EXPECT_THROW(s.set_initial_gap(bad), std::invalid_argument);
+}

@@ -173,6 +173,6 @@ void large_newton(int pairs, double cond)
 
 TEST(Property, LargeNewton900) { large_newton(300, 1e6); }
 
-// About 3 s of CPU (16 Newton iterations, dense LU of the contact zone each); run with
+// About 3 s (11 Newton iterations, a dense LU of the contact zone each); run with
 // --gtest_also_run_disabled_tests.
 TEST(Property, DISABLED_LargeNewton3000) { large_newton(1000, 1e6); }

@@ -128,6 +128,7 @@ class ContactProblem:
         self.flexibility_method = flexibility
         self.timings = {}
         self.increments: list[IncrementResult] = []
+        self.local_problem = None  # rank 0: the last increment's {dim, W, q, mu}
 
         t0 = time.perf_counter()
         self.K = dolfinx.fem.petsc.assemble_matrix(self.a_form, bcs=self.bcs)
@@ -224,6 +225,7 @@ class ContactProblem:
             self.timings["delassus_s"] = time.perf_counter() - t0
             self.W = W
             self.solver = _cpp.IncrementalSolver(d, W, self.mu, self.options)
+            self.solver.set_initial_gap(self.x0)
 
     def _make_outputs(self):
         msh = self.msh
@@ -279,6 +281,12 @@ class ContactProblem:
         error, result = None, None
         if root:
             q = self.B @ upc + self.x0
+            # The increment's local problem u = W λ + q' (slip measured from the last gap),
+            # kept for inspection and for cross-checks with other solvers.
+            q_local = q.copy()
+            tang = np.arange(q.size) % d != 0
+            q_local[tang] -= np.asarray(self.solver.gap())[tang]
+            self.local_problem = {"dim": d, "W": self.W, "q": q_local, "mu": self.mu}
             try:
                 rep = self.solver.step(q)
                 lam = np.asarray(rep.lambda_)
