@@ -120,9 +120,7 @@ if comm.rank == 0:
         "shear_rms_error_rel_mu_p0": shear_rms,
         "stick_pairs": int((states == 1).sum()), "slip_pairs": int((states == 2).sum()),
         "h_contact_m": geo["h_contact"],
-        "mesh": {"cells": int(msh.topology.index_map(2).size_global),
-                 "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
-                 "refine": args.refine, "ranks": comm.size},
+        "mesh": fc.output.mesh_info(V, refine=args.refine),
         "solver": {"iterations": [s.iterations for s in summaries],
                    "answered_by": [s.solver for s in summaries]},
         "timings_s": {**problem.timings, "total": time.perf_counter() - t_start},
@@ -137,7 +135,7 @@ if comm.rank == 0:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         xs = np.linspace(-1.3 * a_ref, 1.3 * a_ref, 600)
-        fig, ax = plt.subplots(figsize=(7, 4))
+        fig, ax = plt.subplots(figsize=(9, 4))
         ax.plot(xs * 1e3, [analytic.hertz_pressure(t, a_ref, p0_ref) / 1e6 for t in xs], "k-",
                 label="Hertz p(x)")
         ax.plot(xs * 1e3, [analytic.cattaneo_mindlin_shear(t, a_ref, c_ref, args.mu, p0_ref) / 1e6
@@ -152,7 +150,7 @@ if comm.rank == 0:
         ax.set_ylabel("traction [MPa]")
         ax.set_title(f"Q/(μP) = {Q / (args.mu * P):.2f}: c {100 * (c / c_ref - 1):+.1f}% of theory")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
         fig.tight_layout()
         fig.savefig(folder / "cattaneo_mindlin.png", dpi=120)
     print(f"results in {folder}/")

@@ -76,3 +76,12 @@ def write_summary(folder, data: dict, comm=MPI.COMM_WORLD):
 
 def increments_table(summaries) -> list[dict]:
     return [asdict(s) for s in summaries]
+
+
+def mesh_info(V, **extra) -> dict:
+    """Size of the problem for a summary: cells, DOFs, ranks (+ any extra entries)."""
+    msh = V.mesh
+    tdim = msh.topology.dim
+    return {"cells": int(msh.topology.index_map(tdim).size_global),
+            "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
+            "ranks": msh.comm.size, **extra}
