@@ -1,0 +1,26 @@
+"""`python3 -m flexcontact info` prints the stack flexcontact runs on; `demos` lists demos."""
+import argparse
+import json
+from pathlib import Path
+
+from .info import describe
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python3 -m flexcontact", description=__doc__)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    sub.add_parser("info", help="versions, MUMPS, the BLAS in use")
+    sub.add_parser("demos", help="list the demos and how to run them")
+    args = ap.parse_args(argv)
+    if args.cmd == "info":
+        print(json.dumps(describe(), indent=2))
+    elif args.cmd == "demos":
+        root = Path(__file__).resolve().parents[3] / "demos"
+        for d in sorted(root.glob("*.py")):
+            doc = next((l[4:].strip() for l in d.read_text().splitlines()
+                        if l.startswith("# # ")), "")
+            print(f"/usr/bin/python3 demos/{d.name:24s} {doc}")
+
+
+if __name__ == "__main__":
+    main()
