@@ -248,13 +248,16 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
       switch (old)
       {
       case PairState::stick:
-        if (ln < -ftol)
-          states[k] = PairState::open;
-        else if (lt.norm() > p.mu[k] * ln + ftol)
+        // Slip is tried before open: a stuck pair pulled apart (λ_n < 0) while sheared
+        // may well be sliding, and going straight to open is what makes the plain
+        // iteration cycle (stick → open → stick). A slip pair still in tension opens next.
+        if (lt.norm() > p.mu[k] * ln + ftol && lt.norm() > ftol)
         {
           states[k] = PairState::slip;
           dir.col(k) = -lt / lt.norm(); // the slip opposes the force that broke adhesion
         }
+        else if (ln < -ftol)
+          states[k] = PairState::open;
         break;
       case PairState::slip:
         if (ln < -ftol)
@@ -269,9 +272,15 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
           states[k] = PairState::stick; // the assumed slip reversed
         else if (d == 3 && ut.norm() > gtol)
         {
-          // The seed's explicit method: the next direction is this iterate's slip,
-          // relaxed (omega < 1) once the plain update has been seen to oscillate.
-          Eigen::VectorXd s = omega * ut / ut.norm() + (1.0 - omega) * dir.col(k);
+          // The seed's projection form of the explicit method: the next direction is
+          // that of λ_t − ρ u_t projected on the disc of radius μλ_n, i.e. the assumed
+          // direction weighted by the friction force μλ_n and this iterate's slip by
+          // ρ|u_t| = |u_t|/c_k. The weights are in force units, so a pair that barely
+          // slips keeps its direction and one that slides far takes its slip's; relaxed
+          // further (omega < 1) once the update has been seen to oscillate.
+          const double wf = p.mu[k] * std::max(ln, 0.0);
+          Eigen::VectorXd s = wf * dir.col(k) + ut / c[k];
+          s = omega * s / s.norm() + (1.0 - omega) * dir.col(k);
           if (!(s.norm() > 0.5 * omega))
             s = ut; // the slip turned round: relaxation would cancel, take it as is
           s.normalize();

@@ -32,16 +32,32 @@ SolverOptions chain_of(std::vector<std::string> names)
   return o;
 }
 
-/// @brief A single pair whose plain active set cycles stick → open → stick: the strong
-/// normal–tangential coupling W_nt = 0.8 makes the stick answer pull (λ_n < 0) and the open
-/// answer penetrate (u_n = −1), while the answer is slip. Hand solution, μ = 1/2: slip
-/// against s = −1, λ_t = μ λ_n, normal row λ_n + 0.8 μ λ_n = 1 ⇒ λ = (5/7, 5/14),
-/// u_t = 0.8·5/7 + 5/14 − 2 = −15/14 (along s).
-struct CyclingPair
+/// @brief A single pair with strong normal–tangential coupling (W_nt = 0.8): the stick
+/// answer pulls (λ_n < 0) and the open answer penetrates (u_n = −1), while the answer is
+/// slip. The seed's rule (stick → open on λ_n < 0) cycles stick → open → stick here; trying
+/// slip first does not. Hand solution, μ = 1/2: slip against s = −1, λ_t = μ λ_n, normal
+/// row λ_n + 0.8 μ λ_n = 1 ⇒ λ = (5/7, 5/14), u_t = 0.8·5/7 + 5/14 − 2 = −15/14 (along s).
+struct CoupledPair
 {
   Matrix W = (Matrix(2, 2) << 1.0, 0.8, 0.8, 1.0).finished();
   Vector q = vec({-1.0, -2.0});
   Vector mu = vec({0.5});
+};
+
+/// @brief Two coupled pairs (μ = 1/2) on which the active set cycles
+/// (stick, stick) → (slip, slip) → (open, stick) → (stick, stick). The answer is pair 0
+/// slipping, pair 1 sticking: u_n0 = u_n1 = u_t1 = 0 with λ_t0 = −λ_n0/2 gives
+/// λ = (1/15, −1/30, 53/150, 4/25) and the slip u_t0 = 106/25 > 0 (along s = +1, against
+/// λ_t0 < 0); pair 1 sticks since |λ_t1| = 4/25 < μ λ_n1 = 53/300.
+struct CyclingPairs
+{
+  Matrix W = (Matrix(4, 4) << 15.0, -12.0, -6.0, -8.0, //
+              -12.0, 15.0, 3.0, 3.0,                    //
+              -6.0, 3.0, 15.0, -5.0,                    //
+              -8.0, 3.0, -5.0, 15.0)
+                 .finished();
+  Vector q = vec({2.0, 4.0, -4.0, 0.0});
+  Vector mu = vec({0.5, 0.5});
 };
 } // namespace
 
@@ -204,22 +220,35 @@ TEST(ActiveSet, RejectsInconsistentInputs)
                std::invalid_argument);
 }
 
+TEST(ActiveSet, SlipBeforeOpenSolvesTheCoupledPair)
+{
+  const CoupledPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  // Stick: λ = −W⁻¹ q = (−5/3, 10/3) pulls and is sheared beyond the cone → slip, not open.
+  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.residual;
+  EXPECT_FALSE(r.cycled);
+  EXPECT_NEAR(r.lambda[0], 5.0 / 7.0, 1e-12);
+  EXPECT_NEAR(r.lambda[1], 5.0 / 14.0, 1e-12);
+  EXPECT_NEAR(r.u[1], -15.0 / 14.0, 1e-12);
+  EXPECT_EQ(r.states[0], PairState::slip);
+}
+
 TEST(ActiveSet, PlainIterationCyclesOnStrongCoupling)
 {
-  const CyclingPair c;
+  const CyclingPairs c;
   const ProblemView p{2, c.W, c.q, c.mu};
-  // Stick: λ = −W⁻¹ q = (−5/3, 10/3) pulls → open; open: u_n = −1 → stick again.
   const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
   EXPECT_TRUE(r.cycled);
   EXPECT_FALSE(r.converged);
-  EXPECT_EQ(r.iterations, 2);
+  EXPECT_EQ(r.iterations, 3);
   EXPECT_TRUE(r.lambda.allFinite());
   EXPECT_GT(r.residual, 1e-3);
 }
 
 TEST(Dispatcher, FallsBackWhenTheActiveSetCycles)
 {
-  const CyclingPair c;
+  const CyclingPairs c;
   const ProblemView p{2, c.W, c.q, c.mu};
   const SolveReport r = solve(p, Vector(), {}, chain_of({"active_set", "newton_ac"}));
   ASSERT_TRUE(r.converged) << r.residual;
@@ -230,10 +259,13 @@ TEST(Dispatcher, FallsBackWhenTheActiveSetCycles)
   EXPECT_NE(r.attempts[1].find("converged"), std::string::npos);
   EXPECT_LE(r.residual, 1e-10);
   EXPECT_LE(natural_map_residual(p, r.lambda), 1e-10); // certified independently
-  EXPECT_NEAR(r.lambda[0], 5.0 / 7.0, 1e-9);
-  EXPECT_NEAR(r.lambda[1], 5.0 / 14.0, 1e-9);
-  EXPECT_NEAR(r.u[1], -15.0 / 14.0, 1e-9);
+  EXPECT_NEAR(r.lambda[0], 1.0 / 15.0, 1e-9);
+  EXPECT_NEAR(r.lambda[1], -1.0 / 30.0, 1e-9);
+  EXPECT_NEAR(r.lambda[2], 53.0 / 150.0, 1e-9);
+  EXPECT_NEAR(r.lambda[3], 4.0 / 25.0, 1e-9);
+  EXPECT_NEAR(r.u[1], 106.0 / 25.0, 1e-9);
   EXPECT_EQ(r.states[0], PairState::slip);
+  EXPECT_EQ(r.states[1], PairState::stick);
 }
 
 TEST(Dispatcher, DefaultChainAndNames)
@@ -242,7 +274,7 @@ TEST(Dispatcher, DefaultChainAndNames)
   const auto names = solver_names();
   for (const auto& n : default_chain())
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
-  const CyclingPair c;
+  const CyclingPairs c;
   const ProblemView p{2, c.W, c.q, c.mu};
   const SolveReport r = solve(p, Vector(), {}, SolverOptions{});
   EXPECT_TRUE(r.converged);

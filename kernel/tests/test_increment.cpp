@@ -148,17 +148,22 @@ TEST(Increment, ValidationNamesWhatIsWrong)
 
 TEST(Increment, FailedIncrementLeavesHistoryUnchanged)
 {
-  // The single-pair problem on which the plain active set cycles (test_active_set.cpp).
-  const Matrix W = (Matrix(2, 2) << 1.0, 0.8, 0.8, 1.0).finished();
+  // The two-pair problem on which the plain active set cycles (test_active_set.cpp).
+  const Matrix W = (Matrix(4, 4) << 15.0, -12.0, -6.0, -8.0, //
+                    -12.0, 15.0, 3.0, 3.0,                    //
+                    -6.0, 3.0, 15.0, -5.0,                    //
+                    -8.0, 3.0, -5.0, 15.0)
+                       .finished();
+  const Vector mu = vec({0.5, 0.5}), q = vec({2.0, 4.0, -4.0, 0.0});
   SolverOptions only_active_set;
   only_active_set.chain = {"active_set"};
-  IncrementalSolver inc(2, W, vec({0.5}), only_active_set);
-  inc.step(vec({1.0, 0.0})); // apart: open
+  IncrementalSolver inc(2, W, mu, only_active_set);
+  inc.step(vec({1.0, 0.0, 1.0, 0.0})); // apart: open
   ASSERT_EQ(inc.states()[0], PairState::open);
   const Vector x = inc.gap(), l = inc.force();
   try
   {
-    inc.step(vec({-1.0, -2.0}));
+    inc.step(q);
     FAIL() << "the cycling increment was accepted";
   }
   catch (const ConvergenceError& e)
@@ -174,11 +179,12 @@ TEST(Increment, FailedIncrementLeavesHistoryUnchanged)
   EXPECT_EQ(inc.force(), l);
   EXPECT_EQ(inc.states()[0], PairState::open);
 
-  // The default chain falls back and solves the same increment (hand solution 5/7, 5/14).
-  IncrementalSolver robust(2, W, vec({0.5}));
-  robust.step(vec({-1.0, -2.0}));
-  EXPECT_NEAR(robust.force()[0], 5.0 / 7.0, 1e-9);
-  EXPECT_NEAR(robust.force()[1], 5.0 / 14.0, 1e-9);
+  // The default chain falls back and solves the same increment (hand solution in
+  // test_active_set.cpp: λ = (1/15, −1/30, 53/150, 4/25)).
+  IncrementalSolver robust(2, W, mu);
+  robust.step(q);
+  EXPECT_NEAR(robust.force()[0], 1.0 / 15.0, 1e-9);
+  EXPECT_NEAR(robust.force()[2], 53.0 / 150.0, 1e-9);
 }
 
 // An initial tangential offset of a pair is geometry, not slip: with the initial gap set,

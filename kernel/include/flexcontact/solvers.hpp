@@ -15,6 +15,10 @@ namespace flexcontact
 {
 /// @brief Feng–Touzot active-set method (the seed's eqs. 12–18): stick/slip/open rows, 2D slip
 /// direction ±t, 3D slip direction from the previous iterate (the seed's explicit method).
+/// Switching: a stick pair outside the Coulomb cone goes to slip before a pulled one goes to
+/// open (the seed opens it at once, which cycles on strongly coupled pairs); slip → stick
+/// when the slip reverses, slip → open on λ_n < 0, open → stick on u_n < 0. 3D directions
+/// use the projection weighting μλ_n s + ρ u_t (relaxed when they oscillate).
 /// Cycle detection: a revisited state vector stops it with cycled=true.
 /// @param states0 starting states per pair (empty: all stick)
 SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
