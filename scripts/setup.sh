@@ -5,7 +5,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 
 packages=(
-  cmake g++ make pkg-config
+  cmake g++ make pkg-config python3-dev libblas-dev
   python3-dolfinx libdolfinx-dev petsc-dev python3-petsc4py python3-mpi4py openmpi-bin
   gmsh python3-gmsh libeigen3-dev pybind11-dev python3-pybind11
   googletest libgtest-dev python3-pytest python3-scipy python3-matplotlib python3-tqdm
@@ -19,7 +19,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "Installing Debian packages: ${missing[*]}"
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
 
 cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
