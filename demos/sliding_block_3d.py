@@ -61,7 +61,10 @@ steel = forms.Material(E_Pa=200e9, nu=0.3, name="steel")
 V = compat.vector_space(msh)
 u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
 dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
-a = forms.elasticity_form(u, v, {tags.BASE: steel, tags.UPPER: aluminium}, dx, "3d")
+materials = {tags.BASE: steel, tags.UPPER: aluminium}
+a = forms.elasticity_form(u, v, materials, dx, "3d")
+# Piecewise-constant Lamé fields, so the von Mises stress uses each body's own material.
+lame = forms.lame_fields(msh, cells, materials)
 
 fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
 top, (top_x, top_y, top_z) = fc.dirichlet(V, facets, tags.LOADED)
@@ -70,7 +73,7 @@ problem = fc.ContactProblem(
     fc.ContactInterface(facets, slave=tags.SLAVE, master=tags.MASTER, mu=args.mu,
                         name="block/base"),
     bodies=(cells, {"base": tags.BASE, "block": tags.UPPER}),
-    stress=lambda w: forms.von_mises(w, aluminium, "3d"))
+    stress=lambda w: forms.von_mises(w, lame, "3d"))
 
 # %% [markdown]
 # ## Load path

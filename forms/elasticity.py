@@ -147,7 +147,7 @@ def lame_fields(msh, cell_tags, materials, kind="3d"):
     import dolfinx.fem as fem
     check_kind(kind)
     _check_tags_covered(cell_tags, materials)
-    V0 = fem.FunctionSpace(msh, ("DG", 0))
+    V0 = fem.functionspace(msh, ("DG", 0)) if hasattr(fem, "functionspace") else fem.FunctionSpace(msh, ("DG", 0))
     mu, lmbda = fem.Function(V0, name="mu_Pa"), fem.Function(V0, name="lambda_Pa")
     tdim = msh.topology.dim
     n_local = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
