@@ -2,19 +2,83 @@
 #pragma once
 
 /// @file contact_testing.hpp
-/// @brief Test helpers: random SPD Delassus matrices and an independent check of the
-/// Signorini–Coulomb laws, so that tests do not trust any solver's own stopping test.
+/// @brief Test helpers: random SPD Delassus matrices, an independent check of the
+/// Signorini–Coulomb laws (so that tests do not trust any solver's own stopping test), and
+/// the small builders and hand-solved problems that several test files share.
 
+#include "flexcontact/pairs.hpp"
 #include "flexcontact/problem.hpp"
 #include "flexcontact/residual.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace flexcontact::testing
 {
+/// @brief A vector written out in place, so that hand-derived values read as in the
+/// derivation next to them.
+inline Vector vec(std::initializer_list<double> v)
+{
+  Vector x(static_cast<Eigen::Index>(v.size()));
+  Eigen::Index i = 0;
+  for (double a : v)
+    x[i++] = a;
+  return x;
+}
+
+/// @brief A pair with the frame of normal n.
+inline ContactPair make_pair(int slave, std::vector<int> masters, std::vector<double> weights,
+                             const Vector& n)
+{
+  ContactPair c;
+  c.slave = slave;
+  c.masters = std::move(masters);
+  c.weights = std::move(weights);
+  c.frame = frame_from_normal(n);
+  return c;
+}
+
+/// @brief Default options except for the solver chain.
+inline SolverOptions chain_of(std::vector<std::string> names)
+{
+  SolverOptions o;
+  o.chain = std::move(names);
+  return o;
+}
+
+/// @brief Two coupled pairs (μ = 1/2) on which the active set cycles
+/// (stick, stick) → (slip, slip) → (open, stick) → (stick, stick). The answer is pair 0
+/// slipping, pair 1 sticking: u_n0 = u_n1 = u_t1 = 0 with λ_t0 = −λ_n0/2 gives
+/// λ = (1/15, −1/30, 53/150, 4/25) and the slip u_t0 = 106/25 > 0 (along s = +1, against
+/// λ_t0 < 0); pair 1 sticks since |λ_t1| = 4/25 < μ λ_n1 = 53/300.
+struct CyclingPairs
+{
+  Matrix W = (Matrix(4, 4) << 15.0, -12.0, -6.0, -8.0, //
+              -12.0, 15.0, 3.0, 3.0,                    //
+              -6.0, 3.0, 15.0, -5.0,                    //
+              -8.0, 3.0, -5.0, 15.0)
+                 .finished();
+  Vector q = vec({2.0, 4.0, -4.0, 0.0});
+  Vector mu = vec({0.5, 0.5});
+};
+
+/// @brief Three decoupled 3D pairs (W = 2I, μ = 0.4) that come out open, stick and slip:
+/// q_n0 > 0 opens pair 0; pair 1 sticks with λ = −q/2, |λ_t| ≈ .07 < μλ_n = .2; pair 2's
+/// stick force |λ_t| = .25 is outside the cone, so it slips with λ_t = −.2 (.6, .8).
+struct OpenStickSlipPairs
+{
+  Matrix W = 2.0 * Matrix::Identity(9, 9);
+  Vector q = vec({1.0, 0.2, 0.0, -1.0, 0.1, 0.1, -1.0, 0.3, 0.4});
+  Vector mu = vec({0.4, 0.4, 0.4});
+  Vector lambda = vec({0.0, 0.0, 0.0, 0.5, -0.05, -0.05, 0.5, -0.12, -0.16});
+};
+
 /// @brief Random SPD n×n matrix with eigenvalues log-spaced in [1/cond, 1]·scale, rotated by
 /// a product of random Householder reflections (O(n²) each, dense result).
 inline Matrix random_spd(int n, double cond, unsigned seed, double scale = 1.0,
@@ -113,23 +177,17 @@ inline std::vector<ExactCase> exact_cases()
   std::vector<ExactCase> c;
   Matrix W2(2, 2);
   W2 << 2.0, 0.5, 0.5, 1.0;
-  auto v = [](std::initializer_list<double> x)
-  {
-    Vector r(static_cast<Eigen::Index>(x.size()));
-    int i = 0;
-    for (double a : x)
-      r[i++] = a;
-    return r;
-  };
-  c.push_back({"2d_open", 2, W2, v({1.0, 0.3}), v({0.5}), v({0.0, 0.0})});
-  c.push_back({"2d_stick", 2, W2, v({-1.0, 0.1}), v({1.0}), v({0.6, -0.4})});
-  c.push_back({"2d_slip", 2, W2, v({-1.0, 0.1}), v({0.5}), v({4.0 / 7, -2.0 / 7})});
+  c.push_back({"2d_open", 2, W2, vec({1.0, 0.3}), vec({0.5}), vec({0.0, 0.0})});
+  c.push_back({"2d_stick", 2, W2, vec({-1.0, 0.1}), vec({1.0}), vec({0.6, -0.4})});
+  c.push_back({"2d_slip", 2, W2, vec({-1.0, 0.1}), vec({0.5}), vec({4.0 / 7, -2.0 / 7})});
   // q_t < 0: stick λ = (.95, −.3)/1.75 is inside the cone for μ = .5 …
-  c.push_back({"2d_stick_neg", 2, W2, v({-1.0, -0.1}), v({0.5}), v({0.95 / 1.75, -0.3 / 1.75})});
+  c.push_back({"2d_stick_neg", 2, W2, vec({-1.0, -0.1}), vec({0.5}),
+               vec({0.95 / 1.75, -0.3 / 1.75})});
   // … and for q = (−1, −.5), μ = .2 it slips backwards: λ_t = +μλ_n, λ_n = 1/(2 + .1),
   // u_t = .5/2.1 + .2/2.1 − .5 = −1/6 < 0.
-  c.push_back({"2d_slip_neg", 2, W2, v({-1.0, -0.5}), v({0.2}), v({1.0 / 2.1, 0.2 / 2.1})});
-  c.push_back({"2d_frictionless", 2, W2, v({-1.0, 0.1}), v({0.0}), v({0.5, 0.0})});
+  c.push_back({"2d_slip_neg", 2, W2, vec({-1.0, -0.5}), vec({0.2}),
+               vec({1.0 / 2.1, 0.2 / 2.1})});
+  c.push_back({"2d_frictionless", 2, W2, vec({-1.0, 0.1}), vec({0.0}), vec({0.5, 0.0})});
   Matrix W3 = Matrix::Zero(3, 3);
   W3.topLeftCorner(2, 2) = W2;
   W3(2, 2) = 1.0;
@@ -142,15 +200,15 @@ inline std::vector<ExactCase> exact_cases()
     R(2, 2) = std::cos(th);
     const Matrix W = R * W3 * R.transpose();
     const std::string t = std::to_string(th);
-    c.push_back({"3d_stick_" + t, 3, W, R * v({-1.0, 0.1, 0.0}), v({1.0}),
-                 R * v({0.6, -0.4, 0.0})});
-    c.push_back({"3d_slip_" + t, 3, W, R * v({-1.0, 0.1, 0.0}), v({0.5}),
-                 R * v({4.0 / 7, -2.0 / 7, 0.0})});
+    c.push_back({"3d_stick_" + t, 3, W, R * vec({-1.0, 0.1, 0.0}), vec({1.0}),
+                 R * vec({0.6, -0.4, 0.0})});
+    c.push_back({"3d_slip_" + t, 3, W, R * vec({-1.0, 0.1, 0.0}), vec({0.5}),
+                 R * vec({4.0 / 7, -2.0 / 7, 0.0})});
   }
   const Matrix I2 = 2.0 * Matrix::Identity(3, 3);
-  c.push_back({"3d_open", 3, I2, v({0.5, 0.3, 0.4}), v({0.4}), v({0.0, 0.0, 0.0})});
-  c.push_back({"3d_slip_iso", 3, I2, v({-1.0, 0.3, 0.4}), v({0.4}), v({0.5, -0.12, -0.16})});
-  c.push_back({"3d_stick_iso", 3, I2, v({-1.0, 0.3, 0.4}), v({1.0}), v({0.5, -0.15, -0.2})});
+  c.push_back({"3d_open", 3, I2, vec({0.5, 0.3, 0.4}), vec({0.4}), vec({0.0, 0.0, 0.0})});
+  c.push_back({"3d_slip_iso", 3, I2, vec({-1.0, 0.3, 0.4}), vec({0.4}), vec({0.5, -0.12, -0.16})});
+  c.push_back({"3d_stick_iso", 3, I2, vec({-1.0, 0.3, 0.4}), vec({1.0}), vec({0.5, -0.15, -0.2})});
   return c;
 }
 } // namespace flexcontact::testing

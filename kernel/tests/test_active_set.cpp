@@ -4,6 +4,7 @@
 /// @brief The Feng–Touzot active-set method on hand-derived problems, and the dispatcher's
 /// fallback when the plain iteration cycles.
 
+#include "contact_testing.hpp"
 #include "flexcontact/residual.hpp"
 #include "flexcontact/solvers.hpp"
 
@@ -13,24 +14,35 @@
 #include <cmath>
 
 using namespace flexcontact;
+using namespace flexcontact::testing;
 
 namespace
 {
-Vector vec(std::initializer_list<double> v)
+/// @brief The active set from scratch: no initial λ and no initial states.
+SolveReport solve_cold(const ProblemView& p)
 {
-  Vector x(static_cast<Eigen::Index>(v.size()));
-  Eigen::Index i = 0;
-  for (double a : v)
-    x[i++] = a;
-  return x;
+  return solve_active_set(p, Vector(), {}, SolverOptions{});
 }
 
-SolverOptions chain_of(std::vector<std::string> names)
+/// @brief A spring (normal k, tangential k_t) with gap g0, pushed towards a wall by δ: it
+/// touches when δ > g0 and then λ_n = k (δ − g0).
+struct SpringAndWall
 {
-  SolverOptions o;
-  o.chain = std::move(names);
-  return o;
-}
+  static constexpr double k = 2e3, kt = 5e2, g0 = 0.01;
+  Matrix W = (Matrix(2, 2) << 1.0 / k, 0.0, 0.0, 1.0 / kt).finished();
+  Vector q;
+  Vector mu = vec({0.3});
+  explicit SpringAndWall(double delta) : q(vec({g0 - delta, 0.0})) {}
+};
+
+/// @brief W = I, q = (−1, −2). Stick gives λ = (1, 2), outside the cone for μ = 1/2; slip with
+/// s = −1: λ = (1, 1/2), u_t = 1/2 − 2 = −3/2 along s.
+struct SlidingPair
+{
+  Matrix W = Matrix::Identity(2, 2);
+  Vector q = vec({-1.0, -2.0});
+  Vector mu = vec({0.5});
+};
 
 /// @brief A single pair with strong normal–tangential coupling (W_nt = 0.8): the stick
 /// answer pulls (λ_n < 0) and the open answer penetrates (u_n = −1), while the answer is
@@ -43,32 +55,14 @@ struct CoupledPair
   Vector q = vec({-1.0, -2.0});
   Vector mu = vec({0.5});
 };
-
-/// @brief Two coupled pairs (μ = 1/2) on which the active set cycles
-/// (stick, stick) → (slip, slip) → (open, stick) → (stick, stick). The answer is pair 0
-/// slipping, pair 1 sticking: u_n0 = u_n1 = u_t1 = 0 with λ_t0 = −λ_n0/2 gives
-/// λ = (1/15, −1/30, 53/150, 4/25) and the slip u_t0 = 106/25 > 0 (along s = +1, against
-/// λ_t0 < 0); pair 1 sticks since |λ_t1| = 4/25 < μ λ_n1 = 53/300.
-struct CyclingPairs
-{
-  Matrix W = (Matrix(4, 4) << 15.0, -12.0, -6.0, -8.0, //
-              -12.0, 15.0, 3.0, 3.0,                    //
-              -6.0, 3.0, 15.0, -5.0,                    //
-              -8.0, 3.0, -5.0, 15.0)
-                 .finished();
-  Vector q = vec({2.0, 4.0, -4.0, 0.0});
-  Vector mu = vec({0.5, 0.5});
-};
 } // namespace
 
 TEST(ActiveSet, SpringPressedOntoWall)
 {
-  // Normal spring k, tangential spring k_t, gap g0, imposed approach δ > g0: λ_n = k (δ − g0).
-  const double k = 2e3, kt = 5e2, g0 = 0.01, delta = 0.03;
-  const Matrix W = (Matrix(2, 2) << 1.0 / k, 0.0, 0.0, 1.0 / kt).finished();
-  const Vector q = vec({g0 - delta, 0.0}), mu = vec({0.3});
-  const ProblemView p{2, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const double delta = 0.03, k = SpringAndWall::k, g0 = SpringAndWall::g0;
+  const SpringAndWall c(delta);
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_NEAR(r.lambda[0], k * (delta - g0), 1e-12 * k * delta);
   EXPECT_EQ(r.lambda[1], 0.0);
@@ -81,11 +75,10 @@ TEST(ActiveSet, SpringPressedOntoWall)
 
 TEST(ActiveSet, SpringNotTouchingWall)
 {
-  const double k = 2e3, kt = 5e2, g0 = 0.01, delta = 0.004;
-  const Matrix W = (Matrix(2, 2) << 1.0 / k, 0.0, 0.0, 1.0 / kt).finished();
-  const Vector q = vec({g0 - delta, 0.0}), mu = vec({0.3});
-  const ProblemView p{2, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const double delta = 0.004, g0 = SpringAndWall::g0;
+  const SpringAndWall c(delta);
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_EQ(r.lambda.norm(), 0.0);
   EXPECT_NEAR(r.u[0], g0 - delta, 1e-15);
@@ -96,12 +89,9 @@ TEST(ActiveSet, SpringNotTouchingWall)
 
 TEST(ActiveSet, TwoDimensionalSlipOpposesTheForce)
 {
-  // W = I, q = (−1, −2), μ = 1/2. Stick gives λ = (1, 2), outside the cone; slip with
-  // s = −1: λ = (1, 1/2), u_t = 1/2 − 2 = −3/2 along s.
-  const Matrix W = Matrix::Identity(2, 2);
-  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
-  const ProblemView p{2, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SlidingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_NEAR(r.lambda[0], 1.0, 1e-14);
   EXPECT_NEAR(r.lambda[1], 0.5, 1e-14);
@@ -116,7 +106,7 @@ TEST(ActiveSet, ThreeDimensionalSlipAlongTheLoad)
   const Matrix W = Matrix::Identity(3, 3);
   const Vector q = vec({-1.0, -3.0, -4.0}), mu = vec({0.5});
   const ProblemView p{3, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_LT((r.lambda - vec({1.0, 0.3, 0.4})).norm(), 1e-14);
   EXPECT_LT((r.u - vec({0.0, -2.7, -3.6})).norm(), 1e-14);
@@ -130,7 +120,7 @@ TEST(ActiveSet, ThreeDimensionalSlipDirectionFoundIteratively)
   const Matrix W = (Matrix(3, 3) << 1.0, 0.0, 0.0, 0.0, 2.0, 0.5, 0.0, 0.5, 1.0).finished();
   const Vector q = vec({-1.0, -3.0, -1.0}), mu = vec({0.3});
   const ProblemView p{3, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual << " after " << r.iterations;
   EXPECT_GT(r.iterations, 2);
   EXPECT_NEAR(r.lambda[0], 1.0, 1e-9);
@@ -150,7 +140,7 @@ TEST(ActiveSet, TwoPairsOneOpens)
   W(0, 0) = 2.0, W(0, 2) = 1.0, W(2, 0) = 1.0, W(2, 2) = 2.0, W(1, 1) = 1.0, W(3, 3) = 1.0;
   const Vector q = vec({-1.0, -0.1, 1.0, 0.0}), mu = vec({0.5, 0.5});
   const ProblemView p{2, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_LT((r.lambda - vec({0.5, 0.1, 0.0, 0.0})).norm(), 1e-14);
   EXPECT_LT((r.u - vec({0.0, 0.0, 1.5, 0.0})).norm(), 1e-14);
@@ -161,10 +151,10 @@ TEST(ActiveSet, TwoPairsOneOpens)
 
 TEST(ActiveSet, FrictionlessPairSlipsFreely)
 {
-  const Matrix W = Matrix::Identity(2, 2);
-  const Vector q = vec({-1.0, -2.0}), mu = vec({0.0});
-  const ProblemView p{2, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  SlidingPair c;
+  c.mu[0] = 0.0;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_LT((r.lambda - vec({1.0, 0.0})).norm(), 1e-14);
   EXPECT_EQ(r.states[0], PairState::slip);
@@ -178,7 +168,7 @@ TEST(ActiveSet, SemidefiniteWGivesFiniteAnswers)
   W << 1, 0, 1, 0, 0, 1, 0, 1, 1, 0, 1, 0, 0, 1, 0, 1;
   const Vector q = vec({-1.0, 0.0, -1.0, 0.0}), mu = vec({0.4, 0.4});
   const ProblemView p{2, W, q, mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.lambda.allFinite());
   EXPECT_TRUE(r.converged) << r.residual;
   EXPECT_NEAR(r.lambda[0] + r.lambda[2], 1.0, 1e-12);
@@ -189,7 +179,7 @@ TEST(ActiveSet, SemidefiniteWGivesFiniteAnswers)
   W2(0, 0) = 1.0, W2(1, 1) = 1.0;
   const Vector q2 = vec({-1.0, 0.0, 0.5, 0.0});
   const ProblemView p2{2, W2, q2, mu};
-  const SolveReport r2 = solve_active_set(p2, Vector(), {}, SolverOptions{});
+  const SolveReport r2 = solve_cold(p2);
   ASSERT_TRUE(r2.lambda.allFinite());
   EXPECT_TRUE(r2.converged) << r2.residual;
   EXPECT_LT((r2.lambda - vec({1.0, 0.0, 0.0, 0.0})).norm(), 1e-14);
@@ -199,9 +189,8 @@ TEST(ActiveSet, SemidefiniteWGivesFiniteAnswers)
 TEST(ActiveSet, StartsFromGivenStates)
 {
   // Starting in the answer's states, one solve confirms it.
-  const Matrix W = Matrix::Identity(2, 2);
-  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
-  const ProblemView p{2, W, q, mu};
+  const SlidingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
   const SolveReport r
       = solve_active_set(p, vec({1.0, 0.5}), {PairState::slip}, SolverOptions{});
   ASSERT_TRUE(r.converged);
@@ -211,9 +200,8 @@ TEST(ActiveSet, StartsFromGivenStates)
 
 TEST(ActiveSet, RejectsInconsistentInputs)
 {
-  const Matrix W = Matrix::Identity(2, 2);
-  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
-  const ProblemView p{2, W, q, mu};
+  const SlidingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
   EXPECT_THROW(solve_active_set(p, vec({1.0}), {}, SolverOptions{}), std::invalid_argument);
   EXPECT_THROW(solve_active_set(p, Vector(), {PairState::stick, PairState::stick},
                                 SolverOptions{}),
@@ -225,7 +213,7 @@ TEST(ActiveSet, SlipBeforeOpenSolvesTheCoupledPair)
   const CoupledPair c;
   const ProblemView p{2, c.W, c.q, c.mu};
   // Stick: λ = −W⁻¹ q = (−5/3, 10/3) pulls and is sheared beyond the cone → slip, not open.
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SolveReport r = solve_cold(p);
   ASSERT_TRUE(r.converged) << r.residual;
   EXPECT_FALSE(r.cycled);
   EXPECT_NEAR(r.lambda[0], 5.0 / 7.0, 1e-12);
@@ -238,7 +226,7 @@ TEST(ActiveSet, PlainIterationCyclesOnStrongCoupling)
 {
   const CyclingPairs c;
   const ProblemView p{2, c.W, c.q, c.mu};
-  const SolveReport r = solve_active_set(p, Vector(), {}, SolverOptions{});
+  const SolveReport r = solve_cold(p);
   EXPECT_TRUE(r.cycled);
   EXPECT_FALSE(r.converged);
   EXPECT_EQ(r.iterations, 3);
@@ -284,9 +272,8 @@ TEST(Dispatcher, DefaultChainAndNames)
 
 TEST(Dispatcher, StopsAtTheFirstSolverThatConverges)
 {
-  const Matrix W = Matrix::Identity(2, 2);
-  const Vector q = vec({-1.0, -2.0}), mu = vec({0.5});
-  const ProblemView p{2, W, q, mu};
+  const SlidingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
   const SolveReport r = solve(p, Vector(), {}, chain_of({"active_set", "newton_ac"}));
   ASSERT_TRUE(r.converged);
   EXPECT_EQ(r.solver, "active_set");

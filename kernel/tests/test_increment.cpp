@@ -4,6 +4,7 @@
 /// @brief The incremental driver: a block pushed sideways past μN, path dependence after
 /// unloading, input validation, and a failed increment leaving the history unchanged.
 
+#include "contact_testing.hpp"
 #include "flexcontact/increment.hpp"
 #include "flexcontact/solvers.hpp"
 
@@ -13,18 +14,10 @@
 #include <functional>
 
 using namespace flexcontact;
+using namespace flexcontact::testing;
 
 namespace
 {
-Vector vec(std::initializer_list<double> v)
-{
-  Vector x(static_cast<Eigen::Index>(v.size()));
-  Eigen::Index i = 0;
-  for (double a : v)
-    x[i++] = a;
-  return x;
-}
-
 std::string message_of(const std::function<void()>& f)
 {
   try
@@ -136,9 +129,8 @@ TEST(Increment, ValidationNamesWhatIsWrong)
   Wn(2, 3) = INFINITY;
   EXPECT_NE(message_of([&] { IncrementalSolver(2, Wn, vec({0.3, 0.3})); }).find("W(2, 3)"),
             std::string::npos);
-  SolverOptions bad;
-  bad.chain = {"simplex"};
-  EXPECT_THROW(IncrementalSolver(2, W, vec({0.3, 0.3}), bad), std::invalid_argument);
+  EXPECT_THROW(IncrementalSolver(2, W, vec({0.3, 0.3}), chain_of({"simplex"})),
+               std::invalid_argument);
 
   IncrementalSolver inc(2, W, vec({0.3, 0.3}));
   EXPECT_THROW(inc.step(vec({1.0, 0.0})), std::invalid_argument);
@@ -148,22 +140,14 @@ TEST(Increment, ValidationNamesWhatIsWrong)
 
 TEST(Increment, FailedIncrementLeavesHistoryUnchanged)
 {
-  // The two-pair problem on which the plain active set cycles (test_active_set.cpp).
-  const Matrix W = (Matrix(4, 4) << 15.0, -12.0, -6.0, -8.0, //
-                    -12.0, 15.0, 3.0, 3.0,                    //
-                    -6.0, 3.0, 15.0, -5.0,                    //
-                    -8.0, 3.0, -5.0, 15.0)
-                       .finished();
-  const Vector mu = vec({0.5, 0.5}), q = vec({2.0, 4.0, -4.0, 0.0});
-  SolverOptions only_active_set;
-  only_active_set.chain = {"active_set"};
-  IncrementalSolver inc(2, W, mu, only_active_set);
+  const CyclingPairs c;
+  IncrementalSolver inc(2, c.W, c.mu, chain_of({"active_set"}));
   inc.step(vec({1.0, 0.0, 1.0, 0.0})); // apart: open
   ASSERT_EQ(inc.states()[0], PairState::open);
   const Vector x = inc.gap(), l = inc.force();
   try
   {
-    inc.step(q);
+    inc.step(c.q);
     FAIL() << "the cycling increment was accepted";
   }
   catch (const ConvergenceError& e)
@@ -179,10 +163,10 @@ TEST(Increment, FailedIncrementLeavesHistoryUnchanged)
   EXPECT_EQ(inc.force(), l);
   EXPECT_EQ(inc.states()[0], PairState::open);
 
-  // The default chain falls back and solves the same increment (hand solution in
-  // test_active_set.cpp: λ = (1/15, −1/30, 53/150, 4/25)).
-  IncrementalSolver robust(2, W, mu);
-  robust.step(q);
+  // The default chain falls back and solves the same increment (hand solution at
+  // CyclingPairs: λ = (1/15, −1/30, 53/150, 4/25)).
+  IncrementalSolver robust(2, c.W, c.mu);
+  robust.step(c.q);
   EXPECT_NEAR(robust.force()[0], 1.0 / 15.0, 1e-9);
   EXPECT_NEAR(robust.force()[2], 53.0 / 150.0, 1e-9);
 }
@@ -191,18 +175,9 @@ TEST(Increment, FailedIncrementLeavesHistoryUnchanged)
 // a stick pair keeps it and the first increment shows no slip.
 TEST(Increment, InitialGapIsNotSlip)
 {
-  using namespace flexcontact;
-  Matrix W(2, 2);
-  W << 1.0, 0.0, 0.0, 1.0;
-  Vector mu(1);
-  mu << 0.5;
-  IncrementalSolver s(2, W, mu);
-  Vector x0(2);
-  x0 << 0.0, 0.3; // touching, tangential offset 0.3
-  s.set_initial_gap(x0);
-  Vector q(2);
-  q << -1.0, 0.3; // pressed by 1, no tangential load
-  const SolveReport& r = s.step(q);
+  IncrementalSolver s(2, Matrix::Identity(2, 2), vec({0.5}));
+  s.set_initial_gap(vec({0.0, 0.3})); // touching, tangential offset 0.3
+  const SolveReport& r = s.step(vec({-1.0, 0.3})); // pressed by 1, no tangential load
   ASSERT_TRUE(r.converged);
   EXPECT_NEAR(r.lambda[0], 1.0, 1e-12);
   EXPECT_NEAR(r.lambda[1], 0.0, 1e-12);

@@ -3,6 +3,7 @@
 /// @file test_pairs.cpp
 /// @brief Frames, the gap operator B, the initial gap and W = B F* Bᵀ against hand values.
 
+#include "contact_testing.hpp"
 #include "flexcontact/pairs.hpp"
 
 #include <gtest/gtest.h>
@@ -10,30 +11,7 @@
 #include <cmath>
 
 using namespace flexcontact;
-
-namespace
-{
-Vector vec(std::initializer_list<double> v)
-{
-  Vector x(static_cast<Eigen::Index>(v.size()));
-  Eigen::Index i = 0;
-  for (double a : v)
-    x[i++] = a;
-  return x;
-}
-
-/// @brief A pair with the frame of normal n.
-ContactPair make_pair(int slave, std::vector<int> masters, std::vector<double> weights,
-                      const Vector& n)
-{
-  ContactPair c;
-  c.slave = slave;
-  c.masters = std::move(masters);
-  c.weights = std::move(weights);
-  c.frame = frame_from_normal(n);
-  return c;
-}
-} // namespace
+using namespace flexcontact::testing;
 
 TEST(Frame, OrthonormalRightHandedAndNormalFirst)
 {

@@ -1,11 +1,13 @@
 // Copyright flexcontact developers. MIT licence.
 
+#include "contact_testing.hpp"
 #include "flexcontact/residual.hpp"
 
 #include <gtest/gtest.h>
 #include <cmath>
 
 using namespace flexcontact;
+using namespace flexcontact::testing;
 
 namespace
 {
@@ -16,6 +18,15 @@ Matrix W2()
   W << 2.0, 0.5, 0.5, 1.0;
   return W;
 }
+
+/// @brief The coupled pair pressed in and pushed along t, with μ = 1/2 too small to stick:
+/// it slips with λ = (4/7, −2/7) (see exact_cases in contact_testing.hpp).
+struct SlippingPair
+{
+  Matrix W = W2();
+  Vector q = vec({-1.0, 0.1});
+  Vector mu = vec({0.5});
+};
 } // namespace
 
 TEST(Cone, InsideUnchanged)
@@ -98,24 +109,20 @@ TEST(Residual, ZeroOnExactStickSlipOpen2D)
 
 TEST(Residual, PositiveOnPerturbed)
 {
-  const Matrix W = W2();
-  Vector q(2), l(2), mu(1);
-  q << -1.0, 0.1;
-  mu << 0.5;
-  l << 4.0 / 7.0, -2.0 / 7.0;
+  const SlippingPair c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const Vector l = vec({4.0 / 7.0, -2.0 / 7.0});
   for (int i = 0; i < 2; ++i)
   {
     Vector lp = l;
     lp[i] += 1e-4;
-    const double r = natural_map_residual({2, W, q, mu}, lp);
+    const double r = natural_map_residual(p, lp);
     EXPECT_GT(r, 1e-6) << "component " << i;
   }
   // Stick answer is wrong when μ is too small for it.
-  Vector ls(2);
-  ls << 0.6, -0.4;
-  EXPECT_GT(natural_map_residual({2, W, q, mu}, ls), 1e-3);
+  EXPECT_GT(natural_map_residual(p, vec({0.6, -0.4})), 1e-3);
   // Open answer where contact is needed.
-  EXPECT_GT(natural_map_residual({2, W, q, mu}, Vector::Zero(2)), 0.1);
+  EXPECT_GT(natural_map_residual(p, Vector::Zero(2)), 0.1);
 }
 
 TEST(Residual, ScaleInvariant)
@@ -171,37 +178,27 @@ TEST(Residual, ZeroDiagonalNeverNaN)
 
 TEST(Residual, NonFiniteLambdaGivesInfinityNotNaN)
 {
-  const Matrix W = W2();
-  Vector q(2), l(2), mu(1);
-  q << -1.0, 0.1;
-  mu << 0.5;
-  l << std::nan(""), 0.0;
-  EXPECT_TRUE(std::isinf(natural_map_residual({2, W, q, mu}, l)));
+  const SlippingPair c;
+  const Vector l = vec({std::nan(""), 0.0});
+  EXPECT_TRUE(std::isinf(natural_map_residual({2, c.W, c.q, c.mu}, l)));
 }
 
 TEST(Residual, RejectsWrongSizes)
 {
-  const Matrix W = W2();
-  Vector q(2), mu(1), l(3);
-  q << -1.0, 0.1;
-  mu << 0.5;
-  l.setZero();
-  EXPECT_THROW(natural_map_residual({2, W, q, mu}, l), std::invalid_argument);
-  EXPECT_THROW(natural_map_residual({3, W, q, mu}, Vector::Zero(2)), std::invalid_argument);
+  const SlippingPair c;
+  EXPECT_THROW(natural_map_residual({2, c.W, c.q, c.mu}, Vector::Zero(3)),
+               std::invalid_argument);
+  EXPECT_THROW(natural_map_residual({3, c.W, c.q, c.mu}, Vector::Zero(2)),
+               std::invalid_argument);
 }
 
 TEST(ClassifyStates, OpenStickSlip)
 {
-  // Three decoupled 3D pairs: open, stick, slip (W = 2 I).
-  const Matrix W = 2.0 * Matrix::Identity(9, 9);
-  Vector q(9), mu(3), l(9);
-  q << 1.0, 0.2, 0.0, -1.0, 0.1, 0.1, -1.0, 0.3, 0.4;
-  mu << 0.4, 0.4, 0.4;
-  l << 0.0, 0.0, 0.0, 0.5, -0.05, -0.05, 0.5, -0.12, -0.16;
-  const ProblemView p{3, W, q, mu};
-  EXPECT_LT(natural_map_residual(p, l), 1e-15);
-  const Vector u = W * l + q;
-  const auto s = classify_states(p, l, u);
+  const OpenStickSlipPairs c;
+  const ProblemView p{3, c.W, c.q, c.mu};
+  EXPECT_LT(natural_map_residual(p, c.lambda), 1e-15);
+  const Vector u = c.W * c.lambda + c.q;
+  const auto s = classify_states(p, c.lambda, u);
   ASSERT_EQ(s.size(), 3u);
   EXPECT_EQ(s[0], PairState::open);
   EXPECT_EQ(s[1], PairState::stick);
