@@ -251,14 +251,104 @@ Eigen::MatrixXd multi_rhs_solve(PetscErrorScope& err, MPI_Comm comm, int rank, M
   }
   return Fs;
 }
+
+/// @brief F* = (K⁻¹)_cc on rank 0 from MUMPS's computation of selected entries of the
+/// inverse (ICNTL(30)), made with the plain factor F.
+///
+/// PETSc's MatMumpsGetInverse takes the requested pattern as the transpose (MATTRANSPOSEVIRTUAL)
+/// of an AIJ matrix Bt, because MUMPS wants compressed columns and AIJ stores rows: row j of Bt
+/// lists the rows i of column j of K⁻¹ wanted. MUMPS reads it on the host only and requires as
+/// many right-hand sides as rows of K, so Bt is N×N. In parallel PETSc reads the diagonal
+/// block of rank 0's part of the MPIAIJ, so rank 0 owns all N rows and all N columns of Bt and
+/// the other ranks own none. MUMPS overwrites Bt's values with the entries of K⁻¹.
+Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
+                                 PetscInt N, const std::vector<PetscInt>& dofs)
+{
+  const int n_c = static_cast<int>(dofs.size());
+  // Rows of an AIJ matrix are set with sorted columns; pos[k] is the place of sorted[k] in dofs.
+  std::vector<int> pos(n_c);
+  std::iota(pos.begin(), pos.end(), 0);
+  std::sort(pos.begin(), pos.end(), [&dofs](int a, int b) { return dofs[a] < dofs[b]; });
+  std::vector<PetscInt> sorted(n_c);
+  for (int k = 0; k < n_c; ++k)
+    sorted[k] = dofs[pos[k]];
+
+  const PetscInt n_local = rank == 0 ? N : 0;
+  OwnedMat Bt;
+  err.check(MatCreate(comm, &Bt.m), "MatCreate");
+  err.check(MatSetSizes(Bt.m, n_local, n_local, N, N), "MatSetSizes");
+  err.check(MatSetType(Bt.m, MATAIJ), "MatSetType(aij)");
+  std::vector<PetscInt> nnz(n_local, 0);
+  if (rank == 0)
+    for (PetscInt r : sorted)
+      nnz[r] = n_c;
+  err.check(MatSeqAIJSetPreallocation(Bt.m, 0, nnz.data()), "MatSeqAIJSetPreallocation");
+  err.check(MatMPIAIJSetPreallocation(Bt.m, 0, nnz.data(), 0, nullptr),
+            "MatMPIAIJSetPreallocation");
+  if (rank == 0)
+  {
+    // Non-zero placeholders: the pattern is what matters, and AIJ keeps it whatever the value.
+    const std::vector<PetscScalar> ones(n_c, 1.0);
+    for (PetscInt r : sorted)
+      err.check(MatSetValues(Bt.m, 1, &r, n_c, sorted.data(), ones.data(), INSERT_VALUES),
+                "MatSetValues");
+  }
+  err.check(MatAssemblyBegin(Bt.m, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  err.check(MatAssemblyEnd(Bt.m, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  OwnedMat spRHS;
+  err.check(MatCreateTranspose(Bt.m, &spRHS.m), "MatCreateTranspose");
+
+  // MatMumpsGetInverse leaves ICNTL(30) = 1 (and ICNTL(20) = 1, ICNTL(21) = 0) in the factor;
+  // MatSolve resets only ICNTL(20), so a later MatSolve would compute inverse entries again
+  // instead of solving, and in parallel would look for a distributed solution MUMPS no longer
+  // produces. Restore what MatSolve relies on.
+  PetscInt icntl20 = 0, icntl21 = 0;
+  err.check(MatMumpsGetIcntl(F, 20, &icntl20), "MatMumpsGetIcntl(20)");
+  err.check(MatMumpsGetIcntl(F, 21, &icntl21), "MatMumpsGetIcntl(21)");
+  err.check(MatMumpsGetInverse(F, spRHS.m), "MatMumpsGetInverse");
+  check_mumps(err, F, "selected-inverse solve");
+  err.check(MatMumpsSetIcntl(F, 30, 0), "MatMumpsSetIcntl(30)");
+  err.check(MatMumpsSetIcntl(F, 20, icntl20), "MatMumpsSetIcntl(20)");
+  err.check(MatMumpsSetIcntl(F, 21, icntl21), "MatMumpsSetIcntl(21)");
+
+  Eigen::MatrixXd Fs;
+  std::string bad;
+  if (rank == 0)
+  {
+    Fs.setZero(n_c, n_c);
+    for (int k = 0; k < n_c and bad.empty(); ++k)
+    {
+      // Row sorted[k] of Bt is column dofs[pos[k]] of K⁻¹.
+      PetscInt ncols = 0;
+      const PetscInt* cols = nullptr;
+      const PetscScalar* vals = nullptr;
+      err.check(MatGetRow(Bt.m, sorted[k], &ncols, &cols, &vals), "MatGetRow");
+      if (ncols == n_c and std::equal(cols, cols + ncols, sorted.begin()))
+      {
+        for (int l = 0; l < n_c; ++l)
+          Fs(pos[l], pos[k]) = vals[l];
+      }
+      else
+      {
+        bad = "MatMumpsGetInverse returned a pattern other than the requested one (row "
+              + std::to_string(sorted[k]) + ")";
+      }
+      err.check(MatRestoreRow(Bt.m, sorted[k], &ncols, &cols, &vals), "MatRestoreRow");
+    }
+    Fs = 0.5 * (Fs + Fs.transpose()).eval();
+  }
+  throw_collective_if(comm, !bad.empty(), bad,
+                      [](const std::string& w) { throw std::runtime_error(w); });
+  return Fs;
+}
 } // namespace
 
 Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
                                      const std::string& method)
 {
-  if (method != "schur" and method != "matmatsolve")
+  if (method != "schur" and method != "inverse_entries" and method != "matmatsolve")
     throw std::invalid_argument("unknown flexibility method '" + method
-                                + "' (expected 'schur' or 'matmatsolve')");
+                                + "' (expected 'schur', 'inverse_entries' or 'matmatsolve')");
   if (!K)
     throw std::invalid_argument("the stiffness matrix is a null Mat");
 
@@ -295,8 +385,12 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   dofs.resize(n_c);
   MPI_Bcast(dofs.data(), n_c, MPIU_INT, 0, comm);
 
+  // PETSc cannot solve with a Schur-enabled MUMPS factor in parallel, and the returned factor
+  // must serve solves: there, the selected-inverse path gives F* from the one plain factor.
+  const std::string used = (method == "schur" and size > 1) ? "inverse_entries" : method;
+
   Flexibility out;
-  out.method = method;
+  out.method = used;
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
 
@@ -308,8 +402,9 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     out.factorizations = 1;
     out.F.resize(0, 0);
   }
-  else if (method == "schur")
+  else if (used == "schur")
   {
+    // Serial only (see `used`): the Schur-enabled factor also serves MatSolve.
     std::vector<PetscInt> root_dofs = rank == 0 ? dofs : std::vector<PetscInt>();
     double t0 = MPI_Wtime();
     OwnedMat F;
@@ -317,18 +412,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     out.F = inverse_of_schur(err, comm, rank, F.m, n_c, out.schur_s, out.inverse_s);
-    if (size == 1)
-      out.factor = F.release();
-    else
-    {
-      // PETSc's MatSolve does not support a Schur factor in parallel: plain factor for solves.
-      MatDestroy(&F.m);
-      double t1 = MPI_Wtime();
-      int np = 0;
-      out.factor = factorize(err, K, nullptr, np);
-      out.factorization_s += MPI_Wtime() - t1;
-      out.factorizations = 2;
-    }
+    out.factor = F.release();
   }
   else
   {
@@ -338,7 +422,8 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     double t1 = MPI_Wtime();
-    out.F = multi_rhs_solve(err, comm, rank, K, F.m, dofs);
+    out.F = used == "inverse_entries" ? selected_inverse(err, comm, rank, F.m, M, dofs)
+                                      : multi_rhs_solve(err, comm, rank, K, F.m, dofs);
     out.schur_s = MPI_Wtime() - t1;
     out.factor = F.release();
   }

@@ -40,12 +40,13 @@ struct Flexibility
   /// MUMPS Cholesky factor of K; MatSolve(factor, b, x) gives x = K⁻¹ b. The caller owns
   /// one reference (MatDestroy).
   Mat factor = nullptr;
-  std::string method;            ///< "schur" or "matmatsolve"
+  std::string method;            ///< method actually used: "schur", "inverse_entries" or "matmatsolve"
   int n_contact_dofs = 0;        ///< n_c
   int null_pivots = 0;           ///< MUMPS INFOG(28)
-  int factorizations = 0;        ///< sparse factorizations performed (1, or 2: see flexibility())
+  int factorizations = 0;        ///< sparse factorizations performed (always 1)
   double factorization_s = 0;    ///< analysis + numerical factorization (all factorizations)
-  double schur_s = 0;            ///< extracting K*_cc (schur) or the multi-RHS solve (matmatsolve)
+  double schur_s = 0;            ///< extracting K*_cc (schur), the selected-inverse solve
+                                 ///< (inverse_entries) or the multi-RHS solve (matmatsolve)
   double inverse_s = 0;          ///< dense Cholesky inversion of K*_cc (schur only)
 };
 
@@ -54,19 +55,24 @@ struct Flexibility
 /// K must be symmetric (it is flagged MAT_SYMMETRIC); rows/columns of Dirichlet DOFs hold
 /// the identity, as DOLFINx assembles them.
 ///
+/// Every method makes exactly one sparse factorization, and the returned factor is it.
+///
 /// * "schur": MUMPS computes the Schur complement K*_cc = K_cc − K_cr K_rr⁻¹ K_rc inside the
-///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ by a dense Cholesky. In
-///   serial the returned factor is the same factorization (PETSc runs MUMPS's condensation
-///   and expansion phases around the Schur solve, so MatSolve gives K⁻¹b). PETSc cannot
-///   solve with a Schur factor in parallel, so with more than one rank a second, plain
-///   factorization is made for the returned factor (factorizations = 2).
+///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ by a dense Cholesky. The
+///   returned factor is the same factorization (PETSc runs MUMPS's condensation and
+///   expansion phases around the Schur solve, so MatSolve gives K⁻¹b). PETSc cannot solve
+///   with a Schur factor in parallel, so with more than one rank "schur" is replaced by
+///   "inverse_entries" (Flexibility::method says which ran).
+/// * "inverse_entries": one plain factorization, then MUMPS computes the n_c² requested
+///   entries of K⁻¹ directly (ICNTL(30), PETSc's MatMumpsGetInverse), exploiting the sparsity
+///   of the unit right-hand sides. Serial and parallel.
 /// * "matmatsolve": one plain factorization and K X = E_c with the unit vectors of the
 ///   contact DOFs as dense right-hand side; F* = X_c.
 ///
 /// Collective on the communicator of K.
 /// @param K assembled stiffness (MATAIJ family)
 /// @param contact_dofs global row indices of the contact DOFs, on rank 0 (ignored elsewhere)
-/// @param method "schur" or "matmatsolve"
+/// @param method "schur", "inverse_entries" or "matmatsolve"
 /// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
 /// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)
 /// @throws MumpsError on a MUMPS failure, PetscError on a PETSc failure
