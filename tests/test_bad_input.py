@@ -2,7 +2,6 @@
 import math
 import xml.etree.ElementTree as ET
 
-import numpy as np
 import pytest
 import ufl
 from mpi4py import MPI

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -172,12 +172,12 @@ class ContactProblem:
             self.mu = np.zeros(0)
         self.m = self.comm.bcast(self.pairs.m if root else None, root=0)
 
-    def _constrained_mask(self, dofs):
+    def _constrained_mask(self):
         """True for the contact DOFs that a Dirichlet condition fixes (rank 0)."""
         marker = self.K.createVecLeft()
         marker.set(1.0)
         dolfinx.fem.petsc.set_bc(marker, self.bcs, scale=0.0)
-        vals = self._gather(marker, dofs)
+        vals = self._gather(marker)
         marker.destroy()
         return vals == 0.0 if vals is not None else None
 
@@ -190,7 +190,7 @@ class ContactProblem:
         self._seq = PETSc.Vec().createSeq(dofs.size, comm=PETSc.COMM_SELF)
         is_to = PETSc.IS().createStride(dofs.size, 0, 1, comm=PETSc.COMM_SELF)
         self._scatter = PETSc.Scatter().create(self.K.createVecLeft(), is_from, self._seq, is_to)
-        constrained = self._constrained_mask(dofs)
+        constrained = self._constrained_mask()
 
         t0 = time.perf_counter()
         F, self.factor, info = _cpp.flexibility(self.K, dofs, self.flexibility_method)
@@ -248,7 +248,7 @@ class ContactProblem:
             self._stress_expr = self.stress(self.u)
 
     # ---- one increment ---------------------------------------------------------------
-    def _gather(self, vec, dofs=None):
+    def _gather(self, vec):
         self._scatter.scatter(vec, self._seq, addv=PETSc.InsertMode.INSERT,
                               mode=PETSc.ScatterMode.FORWARD)
         return self._seq.array.copy() if self.comm.rank == 0 else None
@@ -273,7 +273,7 @@ class ContactProblem:
         """Solve one increment with the loads and Dirichlet values as they are set now."""
         t0 = time.perf_counter()
         root = self.comm.rank == 0
-        d, m = self.dim, self.m
+        d = self.dim
         p = self._assemble_load()
         up = self.K.createVecRight()
         self.factor.solve(p, up)
@@ -353,7 +353,7 @@ class ContactProblem:
 
     def _write_back(self, inc: IncrementResult):
         root = self.comm.rank == 0
-        d, m = self.dim, self.m
+        d = self.dim
         if root:
             pr = self.pairs
             blocks = pr.dofs[:, :1] // d
@@ -406,15 +406,14 @@ class ContactProblem:
 
 
 def _concat(parts: list[NodePairs]) -> NodePairs:
+    """Pairs of several interfaces in one node-major numbering: all slaves, then all
+    masters in the same order."""
     if len(parts) == 1:
         return parts[0]
-    ms = [p.m for p in parts]
-    slaves = [p.x[:p.m] for p in parts]
-    masters = [p.x[p.m:] for p in parts]
     return NodePairs(
-        x=np.vstack(slaves + masters),
+        x=np.vstack([p.x[:p.m] for p in parts] + [p.x[p.m:] for p in parts]),
         dofs=np.vstack([p.dofs[:p.m] for p in parts] + [p.dofs[p.m:] for p in parts]),
         normal=np.vstack([p.normal for p in parts]),
         area=np.concatenate([p.area for p in parts]),
         area_master=np.concatenate([p.area_master for p in parts]),
-    ) if sum(ms) else parts[0]
+    )
