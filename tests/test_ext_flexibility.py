@@ -1,9 +1,10 @@
 """Flexibility F* = (K^-1)_cc from one MUMPS factorization (dolfinx_ext/src/flexibility.cpp).
 
-Checked against a dense inverse of K on small meshes, the Schur path against the
-multi-right-hand-side path, the returned factor against a dense solve, singular stiffness
-and bad input as Python exceptions, and serial against `mpirun -n 2`.
-Run as a script (under mpirun) it writes F* of both methods to the file given.
+Checked against a dense inverse of K on small meshes, the Schur and selected-inverse
+(MUMPS ICNTL(30)) paths against the multi-right-hand-side path, the returned factor against
+a dense solve, singular stiffness and bad input as Python exceptions, and serial against
+`mpirun -n 2` (where the default "schur" becomes "inverse_entries", still one factorization).
+Run as a script (under mpirun) it writes F* of every method to the file given.
 """
 import os
 import shutil
@@ -88,8 +89,11 @@ def rel(a, b):
     return np.linalg.norm(a - b) / np.linalg.norm(b)
 
 
+METHODS = ["schur", "inverse_entries", "matmatsolve"]
+
+
 @pytest.mark.parametrize("dim,n", [(2, 6), (3, 3)])
-@pytest.mark.parametrize("method", ["schur", "matmatsolve"])
+@pytest.mark.parametrize("method", METHODS)
 def test_flexibility_equals_dense_inverse_block(dim, n, method):
     msh, V, K, tags = elasticity(n, dim)
     s, dofs = contact_dofs(V, tags)
@@ -115,6 +119,25 @@ def test_schur_matches_matmatsolve():
     assert rel(Fs, Fm) < 1e-10
 
 
+@pytest.mark.parametrize("dim,n", [(2, 12), (3, 4)])
+def test_inverse_entries_matches_matmatsolve(dim, n):
+    msh, V, K, tags = elasticity(n, dim)
+    _, dofs = contact_dofs(V, tags)
+    Fi, _, info = fc.flexibility(K, dofs, "inverse_entries")
+    Fm, _, _ = fc.flexibility(K, dofs, "matmatsolve")
+    assert rel(Fi, Fm) < 1e-10
+    assert info["method"] == "inverse_entries" and info["factorizations"] == 1
+
+
+def test_inverse_entries_keeps_contact_dof_order():
+    msh, V, K, tags = elasticity(5, 2)
+    _, dofs = contact_dofs(V, tags)
+    perm = np.random.default_rng(2).permutation(dofs.size)
+    F, _, _ = fc.flexibility(K, dofs, "schur")
+    Fp, _, _ = fc.flexibility(K, dofs[perm], "inverse_entries")
+    assert rel(Fp, F[np.ix_(perm, perm)]) < 1e-10
+
+
 def test_contact_dof_order_is_kept():
     msh, V, K, tags = elasticity(5, 2)
     _, dofs = contact_dofs(V, tags)
@@ -124,21 +147,24 @@ def test_contact_dof_order_is_kept():
     assert rel(Fp, F[np.ix_(perm, perm)]) < 1e-12
 
 
-@pytest.mark.parametrize("method", ["schur", "matmatsolve"])
+@pytest.mark.parametrize("method", METHODS)
 def test_factor_solves_with_K(method):
-    """The returned factor (in serial the Schur-enabled one) still gives x = K^-1 b exactly."""
+    """The returned factor (the Schur-enabled one, or the one that computed inverse entries)
+    still gives x = K^-1 b exactly, solve after solve."""
     msh, V, K, tags = elasticity(6, 2)
     _, dofs = contact_dofs(V, tags)
     _, factor, _ = fc.flexibility(K, dofs, method)
-    b = K.createVecLeft()
-    b.setArray(np.random.default_rng(0).standard_normal(b.getLocalSize()))
-    x = K.createVecRight()
-    factor.solve(b, x)
-    x_ref = np.linalg.solve(dense(K), b.getArray())
-    assert rel(x.getArray(), x_ref) < 1e-10
+    Kd = dense(K)
+    for seed in (0, 1):
+        b = K.createVecLeft()
+        b.setArray(np.random.default_rng(seed).standard_normal(b.getLocalSize()))
+        x = K.createVecRight()
+        factor.solve(b, x)
+        x_ref = np.linalg.solve(Kd, b.getArray())
+        assert rel(x.getArray(), x_ref) < 1e-10
 
 
-@pytest.mark.parametrize("method", ["schur", "matmatsolve"])
+@pytest.mark.parametrize("method", METHODS)
 def test_singular_stiffness_raises(method):
     msh, V, K, tags = elasticity(4, 2, clamped=False)
     _, dofs = contact_dofs(V, tags)
@@ -172,11 +198,12 @@ def _write_flexibility(path):
     for dim, n in [(2, 6), (3, 3)]:
         msh, V, K, tags = elasticity(n, dim)
         s, dofs = contact_dofs(V, tags)
-        for method in ("schur", "matmatsolve"):
+        for method in METHODS:
             F, factor, info = fc.flexibility(K, dofs, method)
             out[f"{method}_{dim}"] = F
-            if method == "schur":
-                assert info["factorizations"] == (1 if comm.size == 1 else 2)
+            # One sparse factorization always; in parallel "schur" runs as "inverse_entries".
+            out[f"{method}_{dim}_factorizations"] = np.array(info["factorizations"])
+            out[f"{method}_{dim}_used"] = np.array(info["method"])
             # the returned factor solves with K in parallel too
             b = K.createVecLeft()
             b.set(1.0)
@@ -208,10 +235,13 @@ def test_two_ranks_match_serial(tmp_path):
         s, dofs = contact_dofs(V, tags)
         # Nodes come sorted by coordinates, so the orders agree whatever the partition.
         assert np.array_equal(par[f"x_{dim}"], s["x"])
-        for method in ("schur", "matmatsolve"):
+        for method in METHODS:
             F, _, _ = fc.flexibility(K, dofs, method)
             assert rel(par[f"{method}_{dim}"], F) < 1e-10
             assert float(par[f"{method}_{dim}_residual"]) < 1e-10
+            assert int(par[f"{method}_{dim}_factorizations"]) == 1
+        assert str(par[f"schur_{dim}_used"]) == "inverse_entries"
+        assert rel(par[f"inverse_entries_{dim}"], par[f"matmatsolve_{dim}"]) < 1e-10
 
 
 if __name__ == "__main__":

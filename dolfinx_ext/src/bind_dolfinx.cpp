@@ -53,6 +53,7 @@ void flexcontact::bind_dolfinx(py::module& m)
         info["n_contact_dofs"] = r.n_contact_dofs;
         info["null_pivots"] = r.null_pivots;
         info["factorizations"] = r.factorizations;
+        info["factorization_retries"] = r.factorization_retries;
         info["factorization_s"] = r.factorization_s;
         info["schur_s"] = r.schur_s;
         info["inverse_s"] = r.inverse_s;
@@ -65,12 +66,15 @@ void flexcontact::bind_dolfinx(py::module& m)
 
 Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); contact_dofs
 (int64 global row indices, on rank 0, empty elsewhere); method "schur" (MUMPS Schur
-complement K*_cc inside the factorization, then F* = inv(K*_cc) by dense Cholesky) or
-"matmatsolve" (solve K X = E_c for the contact unit vectors).
+complement K*_cc inside the factorization, then F* = inv(K*_cc) by dense Cholesky),
+"inverse_entries" (MUMPS computes the requested entries of inv(K), ICNTL(30)) or
+"matmatsolve" (solve K X = E_c for the contact unit vectors). PETSc cannot solve with a
+Schur factor in parallel, so there "schur" runs as "inverse_entries"; info["method"] tells.
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
-factor: the MUMPS factor of K for factor.solve(b, x); info: method, n_contact_dofs,
-null_pivots, factorizations, factorization_s, schur_s, inverse_s. In parallel "schur" makes a
-second, plain factorization for `factor` (PETSc cannot solve with a parallel Schur factor).
+factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; info:
+method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
+workspace), factorization_s,
+schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s.
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
 

@@ -100,31 +100,54 @@ int check_null_pivots(PetscErrorScope& err, Mat F)
 }
 
 /// @brief MUMPS Cholesky of K, optionally with a centralised Schur complement on `schur`
-/// (rank 0's indices; empty elsewhere). Returns the factored matrix.
-Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, int& null_pivots)
+/// (rank 0's indices; empty elsewhere). Returns the factored matrix; `retries` counts the
+/// factorizations that ran out of MUMPS workspace and were redone.
+Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, int& null_pivots,
+              int& retries)
 {
-  OwnedMat F;
-  err.check(MatGetFactor(K, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F.m), "MatGetFactor(mumps)");
-  // ICNTL(24) = 1: detect null pivots (reported in INFOG(28)) instead of dividing by ~0.
-  err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
-  if (schur)
+  // K is factored as symmetric indefinite (LDLᵀ with pivoting), and in parallel MUMPS's
+  // dynamic scheduling depends on the load of the machine: the factorization can outgrow the
+  // workspace the analysis estimated (INFOG(1) = -8 or -9), now and then. MUMPS's remedy is a
+  // larger ICNTL(14); PETSc refuses to repeat the numerical phase on a factor whose last phase
+  // failed, so the whole factorization is redone with a fresh factor.
+  retries = 0;
+  PetscInt icntl14 = 0; // 0: MUMPS's default
+  for (;;)
   {
-    MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
-    OwnedIS is;
-    err.check(ISCreateGeneral(comm, static_cast<PetscInt>(schur->size()), schur->data(),
-                              PETSC_COPY_VALUES, &is.is),
-              "ISCreateGeneral");
-    err.check(MatFactorSetSchurIS(F.m, is.is), "MatFactorSetSchurIS");
+    OwnedMat F;
+    err.check(MatGetFactor(K, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F.m), "MatGetFactor(mumps)");
+    // ICNTL(24) = 1: detect null pivots (reported in INFOG(28)) instead of dividing by ~0.
+    err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
+    if (icntl14 > 0)
+      err.check(MatMumpsSetIcntl(F.m, 14, icntl14), "MatMumpsSetIcntl(14)");
+    if (schur)
+    {
+      MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+      OwnedIS is;
+      err.check(ISCreateGeneral(comm, static_cast<PetscInt>(schur->size()), schur->data(),
+                                PETSC_COPY_VALUES, &is.is),
+                "ISCreateGeneral");
+      err.check(MatFactorSetSchurIS(F.m, is.is), "MatFactorSetSchurIS");
+    }
+    MatFactorInfo info;
+    err.check(MatFactorInfoInitialize(&info), "MatFactorInfoInitialize");
+    err.check(MatCholeskyFactorSymbolic(F.m, K, nullptr, &info), "MatCholeskyFactorSymbolic");
+    check_mumps(err, F.m, "analysis");
+    err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
+    err.check(MatCholeskyFactorNumeric(F.m, K, &info), "MatCholeskyFactorNumeric");
+    PetscInt infog1 = 0; // global: every rank takes the same branch
+    err.check(MatMumpsGetInfog(F.m, 1, &infog1), "MatMumpsGetInfog");
+    if ((infog1 == -8 or infog1 == -9) and retries < 3)
+    {
+      err.check(MatMumpsGetIcntl(F.m, 14, &icntl14), "MatMumpsGetIcntl(14)");
+      icntl14 = std::max<PetscInt>(2 * icntl14, 50);
+      ++retries;
+      continue;
+    }
+    check_mumps(err, F.m, "factorization");
+    null_pivots = check_null_pivots(err, F.m);
+    return F.release();
   }
-  MatFactorInfo info;
-  err.check(MatFactorInfoInitialize(&info), "MatFactorInfoInitialize");
-  err.check(MatCholeskyFactorSymbolic(F.m, K, nullptr, &info), "MatCholeskyFactorSymbolic");
-  check_mumps(err, F.m, "analysis");
-  err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
-  err.check(MatCholeskyFactorNumeric(F.m, K, &info), "MatCholeskyFactorNumeric");
-  check_mumps(err, F.m, "factorization");
-  null_pivots = check_null_pivots(err, F.m);
-  return F.release();
 }
 
 /// @brief F* = (K*_cc)⁻¹ on rank 0 from the Schur complement of the factor.
@@ -397,7 +420,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   if (n_c == 0)
   {
     double t0 = MPI_Wtime();
-    out.factor = factorize(err, K, nullptr, out.null_pivots);
+    out.factor = factorize(err, K, nullptr, out.null_pivots, out.factorization_retries);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     out.F.resize(0, 0);
@@ -408,7 +431,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     std::vector<PetscInt> root_dofs = rank == 0 ? dofs : std::vector<PetscInt>();
     double t0 = MPI_Wtime();
     OwnedMat F;
-    F.m = factorize(err, K, &root_dofs, out.null_pivots);
+    F.m = factorize(err, K, &root_dofs, out.null_pivots, out.factorization_retries);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     out.F = inverse_of_schur(err, comm, rank, F.m, n_c, out.schur_s, out.inverse_s);
@@ -418,7 +441,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   {
     double t0 = MPI_Wtime();
     OwnedMat F;
-    F.m = factorize(err, K, nullptr, out.null_pivots);
+    F.m = factorize(err, K, nullptr, out.null_pivots, out.factorization_retries);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     double t1 = MPI_Wtime();

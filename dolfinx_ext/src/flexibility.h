@@ -43,7 +43,10 @@ struct Flexibility
   std::string method;            ///< method actually used: "schur", "inverse_entries" or "matmatsolve"
   int n_contact_dofs = 0;        ///< n_c
   int null_pivots = 0;           ///< MUMPS INFOG(28)
-  int factorizations = 0;        ///< sparse factorizations performed (always 1)
+  int factorizations = 0;        ///< sparse factorizations kept (always 1)
+  /// factorizations redone because MUMPS ran out of its estimated workspace (INFOG(1) = -8/-9;
+  /// happens now and then in parallel, where MUMPS's dynamic scheduling follows the load)
+  int factorization_retries = 0;
   double factorization_s = 0;    ///< analysis + numerical factorization (all factorizations)
   double schur_s = 0;            ///< extracting K*_cc (schur), the selected-inverse solve
                                  ///< (inverse_entries) or the multi-RHS solve (matmatsolve)

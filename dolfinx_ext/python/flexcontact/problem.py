@@ -108,7 +108,10 @@ class ContactProblem:
         so that a singular K is reported with the body's name.
     stress : optional callable u -> UFL scalar (e.g. von Mises) written as a DG0 field.
     solver : kernel SolverOptions (tolerance, max_iterations, chain).
-    flexibility : "schur" (MUMPS Schur complement) or "matmatsolve".
+    flexibility : "schur" (MUMPS Schur complement; on several ranks PETSc cannot solve with
+        that factor, so MUMPS selected inverse entries are used: "inverse_entries"),
+        "inverse_entries", or "matmatsolve" (a multi-right-hand-side solve, the reference).
+        Each makes one sparse factorization, which then serves every solve.
     """
 
     def __init__(self, a, L, bcs: Sequence, contact, *, bodies=None,
