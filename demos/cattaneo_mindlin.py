@@ -112,12 +112,19 @@ if comm.rank == 0:
     q_ref = np.array([analytic.cattaneo_mindlin_shear(xi, a_ref, c_ref, args.mu, p0_ref) for xi in x])
     inside = np.abs(x) < a_ref
     shear_rms = float(np.sqrt(np.mean((np.abs(q[inside, 0]) - q_ref[inside]) ** 2)) / (args.mu * p0_ref))
+    # Stick means no slip in the increment: the largest incremental slip of any stick pair
+    # over the whole load path, relative to the largest displacement.
+    stick_slip = max(float(np.abs(inc.slip_increment[inc.states == 1]).max(initial=0.0))
+                     for inc in problem.increments)
+    umax = max(1e-300, float(np.abs(problem.u.x.array).max()))
     summary = {
         "demo": "cattaneo_mindlin", "units": "SI (m, Pa, N/m)", "mu": args.mu,
         "P": P, "Q": Q, "Q_over_muP": Q / (args.mu * P),
         "c": c, "c_ref": c_ref, "c_error_rel": c / c_ref - 1,
         "a": a_fit, "a_ref": a_ref, "p0": p0, "p0_ref": p0_ref,
         "shear_rms_error_rel_mu_p0": shear_rms,
+        "max_stick_slip_increment_rel": stick_slip / umax,
+        "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
         "stick_pairs": int((states == 1).sum()), "slip_pairs": int((states == 2).sum()),
         "h_contact_m": geo["h_contact"],
         "mesh": fc.output.mesh_info(V, refine=args.refine),

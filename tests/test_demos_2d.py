@@ -62,4 +62,6 @@ def test_cattaneo_mindlin_stick_zone(tmp_path):
     assert 0.2 < s["Q_over_muP"] < 0.9, s
     assert abs(s["c"] / s["c_ref"] - 1) < 0.10, s
     assert s["stick_pairs"] > 0 and s["slip_pairs"] > 0
+    assert s["max_stick_slip_increment_rel"] <= 1e-8
+    assert s["max_penetration_rel"] <= 1e-8
     assert (folder / "cattaneo_mindlin.png").exists()
