@@ -7,6 +7,7 @@
 #include "flexcontact/residual.hpp"
 #include "flexcontact/solvers.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
@@ -67,8 +68,27 @@ SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
   std::vector<std::string> attempts;
   SolveReport best;
   bool have_best = false;
+  if (opt.chain.empty())
+  {
+    // Default chain: a few projection sweeps first. They are cheap (O((m·d)²) each) and
+    // find the open/stick/slip pattern of most pairs, from where Newton converges in one
+    // or two steps: on 2367 unknowns of a sliding block, 50 sweeps + 2 Newton steps took
+    // 0.85 s against 6.6 s for Newton from zero (22 steps of a dense LU).
+    SolverOptions warm = opt;
+    warm.max_iterations = 1; // the projection solver runs 50 × max_iterations sweeps
+    best = solve_projection(p, lambda0, warm);
+    best.solver = "projection";
+    attempts.push_back(attempt_line(best) + " (warm start)");
+    if (opt.verbose)
+      std::cerr << "solve: " << attempts.back() << "\n";
+    have_best = best.lambda.allFinite() && std::isfinite(best.residual);
+    if (!have_best)
+      best = SolveReport{};
+  }
   for (const auto& name : chain)
   {
+    if (have_best && best.converged)
+      break;
     // Later solvers start from the best answer so far: a near-miss of one is a good start
     // for the next. Only the first attempt takes the caller's states; after that the
     // states of the best answer describe its λ.

@@ -279,3 +279,21 @@ TEST(Dispatcher, StopsAtTheFirstSolverThatConverges)
   EXPECT_EQ(r.solver, "active_set");
   EXPECT_EQ(r.attempts.size(), 1u);
 }
+
+// The default chain starts with a few projection sweeps and records them; the answer is
+// still certified by the natural map, and a named chain gets no warm start.
+TEST(Dispatcher, DefaultChainWarmStartIsRecorded)
+{
+  const CyclingPairs c;
+  const ProblemView p{2, c.W, c.q, c.mu};
+  const SolveReport r = solve(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(r.converged);
+  ASSERT_GE(r.attempts.size(), 1u);
+  EXPECT_NE(r.attempts[0].find("projection"), std::string::npos) << r.attempts[0];
+  EXPECT_NE(r.attempts[0].find("warm start"), std::string::npos) << r.attempts[0];
+  EXPECT_LE(natural_map_residual(p, r.lambda), 1e-10);
+  EXPECT_NEAR(r.lambda[2], 53.0 / 150.0, 1e-9);
+  const SolveReport named = solve(p, Vector(), {}, chain_of({"newton_ac"}));
+  ASSERT_EQ(named.attempts.size(), 1u);
+  EXPECT_EQ(named.attempts[0].find("warm start"), std::string::npos);
+}

@@ -41,6 +41,8 @@ std::vector<std::string> solver_names();
 std::vector<std::string> default_chain();
 
 /// @brief Try the solvers of opt.chain (or default_chain()) in order until one converges.
+/// With the default chain, 50 projection sweeps come first as a warm start (recorded in
+/// `attempts`): they settle most pairs' states cheaply, and Newton then needs a step or two.
 /// The report is the converging solver's, with `attempts` listing every try; if none
 /// converges it is the best one's (smallest residual) with converged=false.
 SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
