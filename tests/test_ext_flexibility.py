@@ -6,13 +6,13 @@ a dense solve, singular stiffness and bad input as Python exceptions, and serial
 `mpirun -n 2` (where the default "schur" becomes "inverse_entries", still one factorization).
 Run as a script (under mpirun) it writes F* of every method to the file given.
 """
-import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+
+from conftest import mpirun
 import pytest
 import ufl
 from mpi4py import MPI
@@ -222,13 +222,7 @@ def test_two_ranks_match_serial(tmp_path):
     if MPI.COMM_WORLD.size > 1:
         pytest.skip("runs its own mpirun")
     path = tmp_path / "flex2.npz"
-    cmd = ["mpirun", "-n", "2", "--oversubscribe"]
-    if os.geteuid() == 0:
-        cmd.append("--allow-run-as-root")
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
-    subprocess.run(cmd + ["/usr/bin/python3", __file__, str(path)], check=True, env=env,
-                   timeout=600, capture_output=True)
+    mpirun(2, __file__, path)
     par = np.load(path)
     for dim, n in [(2, 6), (3, 3)]:
         msh, V, K, tags = elasticity(n, dim)

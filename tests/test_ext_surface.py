@@ -5,13 +5,13 @@ against the space's own DOF coordinates, the missing-tag error, write-back round
 serial against `mpirun -n 2`. Run as a script (under mpirun) it writes its results to the
 file given.
 """
-import os
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+
+from conftest import mpirun
 import pytest
 from mpi4py import MPI
 
@@ -182,13 +182,7 @@ def test_two_ranks_match_serial(tmp_path):
     if MPI.COMM_WORLD.size > 1:
         pytest.skip("runs its own mpirun")
     path = tmp_path / "surface2.npz"
-    cmd = ["mpirun", "-n", "2", "--oversubscribe"]
-    if os.geteuid() == 0:
-        cmd.append("--allow-run-as-root")
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
-    subprocess.run(cmd + ["/usr/bin/python3", __file__, str(path)], check=True, env=env,
-                   timeout=600, capture_output=True)
+    mpirun(2, __file__, path)
     par = np.load(path)
     for dim, n in [(2, 6), (3, 3)]:
         msh, V, tags = tagged_box(n, dim)
