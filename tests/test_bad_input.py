@@ -95,3 +95,17 @@ def test_bad_increment_count(setup):
     problem, _ = _problem(setup)
     with pytest.raises(ValueError, match="increments"):
         problem.solve(0)
+
+
+def test_held_pairs_pushed_together_are_named(setup):
+    """Both contact surfaces held by Dirichlet conditions and moved into each other: no
+    contact force can help, so the error says which pair and by how much."""
+    msh, cells, facets, V, a, geo = setup
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    master, _ = fc.dirichlet(V, facets, tags.MASTER)
+    slave, (sx, sy) = fc.dirichlet(V, facets, tags.SLAVE)
+    problem, _ = _problem(setup, bcs=fixed + master + slave)
+    sy.value = -1e-6
+    with pytest.raises(fc.ConvergenceError, match=r"increment 1: .*held by Dirichlet.*penetrates by 1.000e-06 m"):
+        problem.step()
+    assert problem.increments == []

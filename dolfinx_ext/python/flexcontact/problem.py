@@ -290,7 +290,10 @@ class ContactProblem:
             tang = np.arange(q.size) % d != 0
             q_local[tang] -= np.asarray(self.solver.gap())[tang]
             self.local_problem = {"dim": d, "W": self.W, "q": q_local, "mu": self.mu}
+            error = self._held_and_penetrating(q)
             try:
+                if error:
+                    raise _cpp.ConvergenceError(error)
                 rep = self.solver.step(q)
                 lam = np.asarray(rep.lambda_)
                 r_c = self.B.T @ lam
@@ -318,6 +321,27 @@ class ContactProblem:
         inc = self._record(result, time.perf_counter() - t0)
         self._write_back(inc)
         return inc
+
+    def _held_and_penetrating(self, q):
+        """Message naming the pairs that cannot be separated, or None (rank 0).
+
+        A pair whose nodes are all held by Dirichlet conditions has no normal flexibility;
+        if the prescribed motion makes it penetrate, no contact force can open it and the
+        problem has no solution (iterations would only make λ grow).
+        """
+        d = self.dim
+        wn = np.diag(self.W)[::d]
+        rigid = wn <= 1e-12 * max(float(wn.max(initial=0.0)), 1e-300)
+        scale = max(float(np.abs(q).max(initial=0.0)), 1e-300)
+        bad = np.flatnonzero(rigid & (q[::d] < -1e-12 * scale))
+        if bad.size == 0:
+            return None
+        k = int(bad[0])
+        return (f"{bad.size} contact pair(s) are held by "
+                f"Dirichlet conditions on both sides and pushed into each other, so no contact "
+                f"force can separate them; e.g. the slave node at {self.pairs.x[k].tolist()} "
+                f"penetrates by {-q[k * d]:.3e} m. Release one side or change the prescribed "
+                f"displacements")
 
     def _record(self, result, elapsed) -> IncrementResult:
         root = self.comm.rank == 0
