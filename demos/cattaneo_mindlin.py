@@ -128,19 +128,14 @@ if comm.rank == 0:
         "stick_pairs": int((states == 1).sum()), "slip_pairs": int((states == 2).sum()),
         "h_contact_m": geo["h_contact"],
         "mesh": fc.output.mesh_info(V, refine=args.refine),
-        "solver": {"iterations": [s.iterations for s in summaries],
-                   "answered_by": [s.solver for s in summaries]},
-        "timings_s": {**problem.timings, "total": time.perf_counter() - t_start},
-        "increments": fc.output.increments_table(summaries),
+        **fc.output.run_record(problem, summaries, t_start),
         "profile": {"x": x, "pressure": p, "traction": q[:, 0], "state": states},
     }
     fc.write_summary(folder, summary)
     print(f"Cattaneo–Mindlin: Q/(muP) = {Q / (args.mu * P):.3f}, c = {c:.4e} m "
           f"(ref {c_ref:.4e}, {100 * (c / c_ref - 1):+.1f}%)")
     if not args.no_plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = fc.output.pyplot()
         xs = np.linspace(-1.3 * a_ref, 1.3 * a_ref, 600)
         fig, ax = plt.subplots(figsize=(9, 4))
         ax.plot(xs * 1e3, [analytic.hertz_pressure(t, a_ref, p0_ref) / 1e6 for t in xs], "k-",

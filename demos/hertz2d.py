@@ -122,14 +122,7 @@ if comm.rank == 0:
         "closed_pairs": int((states > 0).sum()),
         "contact_dofs": int(problem.n_contact_dofs),
         "mesh": fc.output.mesh_info(V, h_contact_m=geo["h_contact"], refine=args.refine),
-        "solver": {"iterations": [s.iterations for s in summaries],
-                   "answered_by": [s.solver for s in summaries],
-                   "residual_max": max(s.residual for s in summaries)},
-        "timings_s": {**problem.timings, **{k: v for k, v in problem.flex_info.items()
-                                            if k.endswith("_s")},
-                      "increments": [s.time_s for s in summaries],
-                      "total": time.perf_counter() - t_start},
-        "increments": fc.output.increments_table(summaries),
+        **fc.output.run_record(problem, summaries, t_start),
         "profile": {"x": x, "pressure": p, "traction": q[:, 0], "state": states},
     }
     fc.write_summary(folder, summary)
@@ -137,9 +130,7 @@ if comm.rank == 0:
           f"p0 = {p0:.5e} Pa (ref {p0_ref:.5e}, {100 * (p0 / p0_ref - 1):+.2f}%)")
 
     if not args.no_plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = fc.output.pyplot()
         xs = np.linspace(-1.5 * a_ref, 1.5 * a_ref, 400)
         fig, ax = plt.subplots(figsize=(7, 4))
         ax.plot(xs * 1e3, [analytic.hertz_pressure(xi, a_ref, p0_ref) / 1e6 for xi in xs],

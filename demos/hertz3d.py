@@ -171,14 +171,7 @@ if comm.rank == 0:
                  "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
                  "h_contact_m": geo["h_contact"], "h_far_m": geo["h_far"],
                  "refine": args.refine, "ranks": comm.size},
-        "solver": {"iterations": [s.iterations for s in summaries],
-                   "answered_by": [s.solver for s in summaries],
-                   "residual_max": max(s.residual for s in summaries)},
-        "timings_s": {"mesh": t_mesh, **problem.timings,
-                      **{k: v for k, v in problem.flex_info.items() if k.endswith("_s")},
-                      "increments": [s.time_s for s in summaries],
-                      "total": time.perf_counter() - t_start},
-        "increments": fc.output.increments_table(summaries),
+        **fc.output.run_record(problem, summaries, t_start, mesh=t_mesh),
         "profile": {"r": r, "x": xy[:, 0], "y": xy[:, 1], "pressure": p, "state": states},
     }
     fc.write_summary(folder, summary)
@@ -187,9 +180,7 @@ if comm.rank == 0:
           f"{100 * (p0 / p0_ref - 1):+.2f}%)")
 
     if not args.no_plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = fc.output.pyplot()
         rs = np.linspace(0, 1.6 * a_ref, 400)
         fig, ax = plt.subplots(figsize=(7, 4))
         ax.plot(rs * 1e3, [analytic.hertz_pressure(t, a_ref, p0_ref) / 1e6 for t in rs],

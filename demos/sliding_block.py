@@ -116,19 +116,14 @@ if comm.rank == 0:
         "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
         "contact_pairs": int(problem.m),
         "mesh": fc.output.mesh_info(V, refine=args.refine),
-        "solver": {"iterations": [s.iterations for s in summaries],
-                   "answered_by": [s.solver for s in summaries]},
-        "timings_s": {**problem.timings, "total": time.perf_counter() - t_start},
         "push_m": pushes, "N": N, "T": T,
-        "increments": fc.output.increments_table(summaries),
+        **fc.output.run_record(problem, summaries, t_start),
     }
     fc.write_summary(folder, summary)
     print(f"gross slip at increment {i0 + 1}: T = {T[i0]:.5e} N/m, muN = {args.mu * N[i0]:.5e} N/m;"
           f" max T/(muN) over the run = {ratio[n1:].max():.6f}")
     if not args.no_plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = fc.output.pyplot()
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
         px = np.array(pushes[n1:]) * 1e6
         ax1.plot(px, T[n1:] / 1e3, "o-", label="|T| friction force")

@@ -201,18 +201,11 @@ if comm.rank == 0:
         "mesh": {"cells": int(msh.topology.index_map(3).size_global),
                  "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
                  "h_m": geo["h"], "refine": args.refine, "ranks": comm.size},
-        "solver": {"iterations": [s.iterations for s in summaries],
-                   "answered_by": [s.solver for s in summaries],
-                   "residual_max": max(s.residual for s in summaries)},
-        "timings_s": {**problem.timings,
-                      **{k: v for k, v in problem.flex_info.items() if k.endswith("_s")},
-                      "increments": [s.time_s for s in summaries],
-                      "total": time.perf_counter() - t_start},
+        **fc.output.run_record(problem, summaries, t_start),
         "push_m": [p[0] for p in path], "push_angle_deg": theta_push,
         "push_increment_angle_deg": theta_dpush,
         "N": N, "T": T, "T_vector": Tvec, "friction_angle_deg": theta_T,
         "slip_angle_deg": theta_slip, "angle_T_vs_slip_deg": slip_vs_T,
-        "increments": fc.output.increments_table(summaries),
     }
     fc.write_summary(folder, summary)
     print(f"gross slip at increment {i0 + 1} (push {np.degrees(path[i0][1]):.1f}° from x): "
@@ -220,9 +213,7 @@ if comm.rank == 0:
           f"max |T|/(muN) = {ratio[n1:].max():.8f}; "
           f"largest angle between -T and the slip while sliding = {np.nanmax(slip_vs_T):.3f}°")
     if not args.no_plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = fc.output.pyplot()
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
         k = np.arange(1, len(summaries) + 1)
         ax1.plot(k[n1:], T[n1:] / 1e3, "o-", label="|T| friction force")

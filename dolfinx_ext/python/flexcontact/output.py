@@ -85,3 +85,29 @@ def mesh_info(V, **extra) -> dict:
     return {"cells": int(msh.topology.index_map(tdim).size_global),
             "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
             "ranks": msh.comm.size, **extra}
+
+
+def run_record(problem, summaries, t_start: float, **timings_s) -> dict:
+    """What every demo summary holds about the run: the solver per increment (who answered,
+    iterations, worst residual), timings in seconds (set-up, factorization, each increment,
+    total since ``t_start`` on ``time.perf_counter``, plus ``timings_s``) and the
+    per-increment table."""
+    import time
+    return {
+        "solver": {"iterations": [s.iterations for s in summaries],
+                   "answered_by": [s.solver for s in summaries],
+                   "residual_max": max(s.residual for s in summaries)},
+        "timings_s": {**timings_s, **problem.timings,
+                      **{k: v for k, v in problem.flex_info.items() if k.endswith("_s")},
+                      "increments": [s.time_s for s in summaries],
+                      "total": time.perf_counter() - t_start},
+        "increments": increments_table(summaries),
+    }
+
+
+def pyplot():
+    """matplotlib.pyplot drawing to files (no display needed)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
