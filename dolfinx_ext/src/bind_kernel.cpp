@@ -299,68 +299,47 @@ void flexcontact::bind_kernel(py::module& m)
       py::arg("tol") = 1e-8, "Pair states (0 open, 1 stick, 2 slip) read from lambda");
 
   // ---- solvers.hpp ---------------------------------------------------------------------
-  m.def(
+  // Every solver takes the same Python arguments (states0 is ignored by those that do not
+  // use states), checked once here, and runs without the GIL.
+  auto def_solver = [&m](const char* name, auto solver, const char* doc)
+  {
+    m.def(
+        name,
+        [solver](int dim, const Matrix& W, const Vector& q, const Vector& mu,
+                 const std::optional<Vector>& lambda0, const std::optional<IntArray>& states0,
+                 const SolverOptions& options)
+        {
+          Vector l0 = or_empty(lambda0);
+          auto s0 = states_from(states0);
+          check_problem(dim, W, q, mu, l0, s0.size());
+          ProblemView p{dim, W, q, mu};
+          py::gil_scoped_release release;
+          return solver(p, l0, s0, options);
+        },
+        py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"),
+        py::arg("lambda0") = py::none(), py::arg("states0") = py::none(),
+        py::arg("options") = SolverOptions(), doc);
+  };
+  using States = std::vector<PairState>;
+  def_solver(
       "solve",
-      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
-         const std::optional<Vector>& lambda0, const std::optional<IntArray>& states0,
-         const SolverOptions& options)
-      {
-        Vector l0 = or_empty(lambda0);
-        auto s0 = states_from(states0);
-        check_problem(dim, W, q, mu, l0, s0.size());
-        ProblemView p{dim, W, q, mu};
-        py::gil_scoped_release release;
-        return solve(p, l0, s0, options);
-      },
-      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
-      py::arg("states0") = py::none(), py::arg("options") = SolverOptions(),
+      [](const ProblemView& p, const Vector& l0, const States& s0, const SolverOptions& o)
+      { return solve(p, l0, s0, o); },
       "Try the solvers of options.chain in order until one converges; returns a SolveReport");
-
-  m.def(
+  def_solver(
       "solve_active_set",
-      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
-         const std::optional<Vector>& lambda0, const std::optional<IntArray>& states0,
-         const SolverOptions& options)
-      {
-        Vector l0 = or_empty(lambda0);
-        auto s0 = states_from(states0);
-        check_problem(dim, W, q, mu, l0, s0.size());
-        ProblemView p{dim, W, q, mu};
-        py::gil_scoped_release release;
-        return solve_active_set(p, l0, s0, options);
-      },
-      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
-      py::arg("states0") = py::none(), py::arg("options") = SolverOptions(),
+      [](const ProblemView& p, const Vector& l0, const States& s0, const SolverOptions& o)
+      { return solve_active_set(p, l0, s0, o); },
       "Feng-Touzot active-set method (stick/slip/open rows)");
-
-  m.def(
+  def_solver(
       "solve_projection",
-      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
-         const std::optional<Vector>& lambda0, const SolverOptions& options)
-      {
-        Vector l0 = or_empty(lambda0);
-        check_problem(dim, W, q, mu, l0);
-        ProblemView p{dim, W, q, mu};
-        py::gil_scoped_release release;
-        return solve_projection(p, l0, options);
-      },
-      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
-      py::arg("options") = SolverOptions(),
+      [](const ProblemView& p, const Vector& l0, const States&, const SolverOptions& o)
+      { return solve_projection(p, l0, o); },
       "De Saxce-Feng bi-potential projection (Gauss-Seidel over pairs)");
-
-  m.def(
+  def_solver(
       "solve_newton_ac",
-      [](int dim, const Matrix& W, const Vector& q, const Vector& mu,
-         const std::optional<Vector>& lambda0, const SolverOptions& options)
-      {
-        Vector l0 = or_empty(lambda0);
-        check_problem(dim, W, q, mu, l0);
-        ProblemView p{dim, W, q, mu};
-        py::gil_scoped_release release;
-        return solve_newton_ac(p, l0, options);
-      },
-      py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lambda0") = py::none(),
-      py::arg("options") = SolverOptions(),
+      [](const ProblemView& p, const Vector& l0, const States&, const SolverOptions& o)
+      { return solve_newton_ac(p, l0, o); },
       "Semi-smooth Newton on the Alart-Curnier formulation");
 
   m.def("solver_names", &solver_names, "Names accepted in SolverOptions.chain");
