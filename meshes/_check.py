@@ -23,3 +23,16 @@ def less(name: str, value: float, bound_name: str, bound: float):
     """ValueError unless value < bound."""
     if not value < bound:
         raise ValueError(f"{name}={value!r} must be < {bound_name}={bound!r}")
+
+
+def hertz_zone(R, a_expected, zone_factor):
+    """Checked (R, a, w) of a Hertz geometry [m]: radius R, the expected contact half-width
+    a (default R/10, must be < R) and the candidate zone half-width w = zone_factor·a."""
+    R = positive("R", R)
+    a = positive("a_expected", R / 10 if a_expected is None else a_expected)
+    if a >= R:
+        raise ValueError(f"a_expected={a!r} must be < R={R!r} (Hertz needs a << R)")
+    zone_factor = positive("zone_factor", zone_factor, "dimensionless")
+    if zone_factor < 1:
+        raise ValueError(f"zone_factor={zone_factor!r} must be >= 1 (the zone must contain a)")
+    return R, a, zone_factor * a

@@ -52,14 +52,7 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
     ``info`` holds R, a_expected, w, h_contact, h_far, column_radius, column_height, block
     and n_contact_nodes (per surface).
     """
-    R = _check.positive("R", R)
-    a = _check.positive("a_expected", R / 10 if a_expected is None else a_expected)
-    if a >= R:
-        raise ValueError(f"a_expected={a!r} must be < R={R!r} (Hertz needs a << R)")
-    zone_factor = _check.positive("zone_factor", zone_factor, "dimensionless")
-    if zone_factor < 1:
-        raise ValueError(f"zone_factor={zone_factor!r} must be >= 1 (the zone must contain a)")
-    w = zone_factor * a
+    R, a, w = _check.hertz_zone(R, a_expected, zone_factor)
     Rc = _check.positive("column_radius", R / 2 if column_radius is None else column_radius)
     _check.less("column_radius", Rc, "R", R)
     _check.less("zone radius w = zone_factor * a_expected", w, "column_radius", Rc)
