@@ -360,6 +360,8 @@ void flexcontact::bind_kernel(py::module& m)
           py::arg("q"),
           "Solve one increment for the total q = B u_p + x0; returns a SolveReport. Raises "
           "ConvergenceError (history unchanged) if no solver converges")
+      .def("local_q", &IncrementalSolver::local_q, py::arg("q"),
+           "q' of the local problem u = W lambda + q' that step(q) solves next")
       .def("set_initial_gap", &IncrementalSolver::set_initial_gap, py::arg("x0"),
            "Gap before the first increment; the first increment's slip is measured from it")
       .def("gap", [](const IncrementalSolver& s) { return s.gap(); }, "Total gap x of the last increment")

@@ -82,6 +82,16 @@ void IncrementalSolver::set_initial_gap(const Eigen::Ref<const Vector>& x0)
   x_ = x0;
 }
 
+Vector IncrementalSolver::local_q(const Eigen::Ref<const Vector>& q_total) const
+{
+  // The slip of this increment is x_t − x_t,prev: remove the previous tangential gap.
+  Vector q = q_total;
+  for (int k = 0; k < pairs(); ++k)
+    for (int j = 1; j < dim_; ++j)
+      q[k * dim_ + j] -= x_[k * dim_ + j];
+  return q;
+}
+
 const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_total)
 {
   const std::string who = "flexcontact: IncrementalSolver::step: ";
@@ -94,13 +104,7 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
                                   + std::to_string(i / dim_) + ") is " + num(q_total[i])
                                   + "; q must be finite");
 
-  // The slip of this increment is x_t − x_t,prev: remove the previous tangential gap.
-  Vector q = q_total;
-  const int m = pairs();
-  for (int k = 0; k < m; ++k)
-    for (int j = 1; j < dim_; ++j)
-      q[k * dim_ + j] -= x_[k * dim_ + j];
-
+  const Vector q = local_q(q_total);
   const ProblemView view{dim_, W_, q, mu_};
   SolveReport r = solve(view, lambda_, states_, options_);
   if (!r.converged)

@@ -286,10 +286,8 @@ class ContactProblem:
             q = self.B @ upc + self.x0
             # The increment's local problem u = W λ + q' (slip measured from the last gap),
             # kept for inspection and for cross-checks with other solvers.
-            q_local = q.copy()
-            tang = np.arange(q.size) % d != 0
-            q_local[tang] -= np.asarray(self.solver.gap())[tang]
-            self.local_problem = {"dim": d, "W": self.W, "q": q_local, "mu": self.mu}
+            self.local_problem = {"dim": d, "W": self.W, "q": np.asarray(self.solver.local_q(q)),
+                                  "mu": self.mu}
             error = self._held_and_penetrating(q)
             try:
                 if error:

@@ -31,6 +31,10 @@ public:
   /// @throws std::invalid_argument on a wrong size or non-finite values
   void set_initial_gap(const Eigen::Ref<const Vector>& x0);
 
+  /// @brief q' of the local problem u = W λ + q' that step(q_total) solves next: q_total
+  /// with the last increment's tangential gap removed (sizes as for step()).
+  Vector local_q(const Eigen::Ref<const Vector>& q_total) const;
+
   const Vector& gap() const { return x_; }          ///< total gap x of the last increment
   const Vector& force() const { return lambda_; }   ///< λ of the last increment
   const std::vector<PairState>& states() const { return states_; }
