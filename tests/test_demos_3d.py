@@ -11,7 +11,7 @@ import pytest
 from demo_runner import run_demo
 
 HERTZ_REFINE = 1   # finest test mesh: contact elements a/12, about 60,000 DOFs, ~10 s
-SLIDING_REFINE = 0  # 121 pairs; refine 1 (441 pairs) takes ~40 s in the dense 3D solves
+SLIDING_REFINE = 1  # 514 pairs (interface h = 5 mm), about 15 s
 ANGLE_DEG = 3.0    # friction force against the block's mean slip, while it slides
 
 
@@ -76,14 +76,18 @@ def test_sliding_block_3d_friction_follows_the_turning_slip(sliding):
     assert s["final_angle_T_deg"] >= 0.9 * s["turn_deg"], s
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "in 3D the pairs at the first all-slip increment slip in different directions (up to "
-    "~34° at the trailing corners), so |Σλ_t| is below μN there (measured −4.4 % at refine 0, "
-    "−4.0 % at refine 1) although Σ|λ_t| = μN; "
-    "|T| reaches μN within 0.1 % after a few more increments of sliding"))
-def test_sliding_block_3d_onset_force_within_1_percent(sliding):
+def test_sliding_block_3d_gross_slip_starts_at_mu_N(sliding):
+    # Pulled through a soft pad (a force-like tangential load), the block starts to slide
+    # when the friction force reaches μN: target 1 %.
     s, _ = sliding
+    assert s["pad_stiffness_ratio"] <= 0.01
     assert abs(s["q"] / s["q_ref"] - 1) < 0.01, s
+
+
+def test_sliding_block_3d_pad_balances_friction(sliding):
+    # The block's in-plane equilibrium: pad pull + friction = 0 at every increment.
+    s, _ = sliding
+    assert s["pad_vs_friction_rel"] < 1e-10, s
 
 
 @pytest.mark.mpi
