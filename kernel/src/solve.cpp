@@ -7,6 +7,7 @@
 #include "flexcontact/residual.hpp"
 #include "flexcontact/solvers.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -56,6 +57,40 @@ std::string attempt_line(const SolveReport& r)
     line += ", " + std::to_string(r.state_changes) + " state changes";
   line += r.converged ? ", converged" : (r.cycled ? ", cycled" : ", not converged");
   return line;
+}
+
+/// @brief Sets to zero the friction components that move nothing.
+///
+/// A tangential unknown whose column of W is zero (both nodes held along that tangent, e.g.
+/// on a symmetry plane) is not determined by the contact laws: any value inside the cone
+/// solves them, and solvers leave different ones (projection sweeps stop on the cone). Zero
+/// is always admissible: it changes no u, keeps λ_t in the cone, and a pair that slips
+/// along its other tangent needs it (friction opposes the slip). It is also what the
+/// supports then carry, so the reported friction is the force the interface transmits.
+/// W is positive semi-definite, so a zero diagonal entry means a zero row and column.
+void zero_undetermined_friction(const ProblemView& p, SolveReport& r)
+{
+  const int d = p.dim;
+  const double w_scale = p.W.diagonal().cwiseAbs().maxCoeff();
+  const double q_scale = p.q.cwiseAbs().maxCoeff();
+  bool changed = false;
+  for (int k = 0; k < p.pairs(); ++k)
+    for (int i = 1; i < d; ++i)
+    {
+      const int j = k * d + i;
+      // q_j ≠ 0 would be a prescribed slip along j, which does determine the friction.
+      if (std::abs(p.W(j, j)) <= 1e-14 * w_scale && std::abs(p.q(j)) <= 1e-14 * q_scale
+          && r.lambda(j) != 0.0)
+      {
+        r.lambda(j) = 0.0;
+        changed = true;
+      }
+    }
+  if (!changed)
+    return;
+  r.u = p.W * r.lambda + p.q;
+  r.residual = natural_map_residual(p, r.lambda);
+  r.states = classify_states(p, r.lambda, r.u);
 }
 } // namespace
 
@@ -112,6 +147,14 @@ SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
     }
     if (best.converged)
       break;
+  }
+  if (best.lambda.size() == p.q.size() && best.lambda.allFinite())
+  {
+    const double before = best.residual;
+    zero_undetermined_friction(p, best);
+    // Zeroing can only remove a spurious friction component; it must not spoil an answer.
+    if (best.converged && !(best.residual <= std::max(opt.tolerance, before)))
+      best.converged = false;
   }
   best.attempts = std::move(attempts);
   return best;

@@ -116,7 +116,6 @@ class ContactProblem:
 
     def __init__(self, a, L, bcs: Sequence, contact, *, bodies=None,
                  stress: Optional[Callable] = None, solver=None, flexibility: str = "schur"):
-        self.comm = MPI.COMM_WORLD
         self.interfaces = list(contact) if isinstance(contact, (list, tuple)) else [contact]
         if not self.interfaces:
             raise ValueError("no contact interface given")
@@ -125,6 +124,7 @@ class ContactProblem:
         self.L_form = dolfinx.fem.form(L) if L is not None else None
         self.V = a.arguments()[0].ufl_function_space()
         self.msh = self.V.mesh
+        self.comm = self.msh.comm  # the mesh's: it may live on a sub-communicator
         self.dim = self.msh.geometry.dim
         self.stress = stress
         self.options = solver if solver is not None else _cpp.SolverOptions()
