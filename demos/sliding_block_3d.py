@@ -82,7 +82,6 @@ fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
 # k_pad·(g − u) [Pa] on the top, g = s·(cos θ, sin θ) the platen's travel [m].
 top, (top_z,) = fc.dirichlet(V, facets, tags.LOADED, components=[2])
 ds = ufl.Measure("ds", domain=msh, subdomain_data=facets)
-top_area = geo["block"][0] * geo["block"][1]
 k_block = aluminium.mu_Pa / geo["block_height"]          # shear stiffness per area [Pa/m]
 if args.pad_stiffness_ratio <= 0:
     raise SystemExit(f"--pad-stiffness-ratio must be > 0, got {args.pad_stiffness_ratio}")

@@ -120,3 +120,32 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+
+
+# ---- finding OpenCASCADE entities by position (builders call these inside their model) --
+def entities_in(dim, box, owners):
+    """Tags of ``dim``-entities inside the bounding box (with a tiny tolerance) that bound
+    one of the ``owners`` volumes (so coincident faces of the other body are excluded)."""
+    eps = _box_tolerance(box)
+    lo, hi = [v - eps for v in box[:3]], [v + eps for v in box[3:]]
+    found = [t for _, t in gmsh.model.getEntitiesInBoundingBox(*lo, *hi, dim)]
+    own = set()
+    for v in owners:
+        own.update(abs(t) for _, t in gmsh.model.getBoundary([(3, v)], oriented=False))
+    return sorted(t for t in found if t in own)
+
+
+def _box_tolerance(box):
+    """Search margin (m): OpenCASCADE enlarges bounding boxes by its tolerance (~1e-7 m)."""
+    return 1e-6 * max(1.0, max(abs(v) for v in box)) + 1e-6 * max(box[3] - box[0], box[4] - box[1],
+                                                                    box[5] - box[2])
+
+
+def faces_in(x0, y0, z0, x1, y1, z1, owners):
+    return entities_in(2, (x0, y0, z0, x1, y1, z1), owners)
+
+
+def volumes_in(x0, y0, z0, x1, y1, z1):
+    eps = _box_tolerance((x0, y0, z0, x1, y1, z1))
+    return [t for _, t in gmsh.model.getEntitiesInBoundingBox(x0 - eps, y0 - eps, z0 - eps,
+                                                             x1 + eps, y1 + eps, z1 + eps, 3)]

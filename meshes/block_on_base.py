@@ -116,12 +116,12 @@ def build_3d(comm, block=(0.1, 0.1, 0.05), base=(0.3, 0.3, 0.1), h=0.01, h_far=0
         block_box = occ.addBox(-bx / 2, -by / 2, gap, bx, by, bh)
         occ.synchronize()
 
-        base_vol = _volumes_in(-Bx / 2, -By / 2, -Bd, Bx / 2, By / 2, 0)
+        base_vol = _gmsh.volumes_in(-Bx / 2, -By / 2, -Bd, Bx / 2, By / 2, 0)
         block_vol = [block_box]
-        patch = _faces_in(-bx / 2, -by / 2, 0, bx / 2, by / 2, 0, base_vol)
-        bottom = _faces_in(-Bx / 2, -By / 2, -Bd, Bx / 2, By / 2, -Bd, base_vol)
-        b_bot = _faces_in(-bx / 2, -by / 2, gap, bx / 2, by / 2, gap, block_vol)
-        b_top = _faces_in(-bx / 2, -by / 2, gap + bh, bx / 2, by / 2, gap + bh, block_vol)
+        patch = _gmsh.faces_in(-bx / 2, -by / 2, 0, bx / 2, by / 2, 0, base_vol)
+        bottom = _gmsh.faces_in(-Bx / 2, -By / 2, -Bd, Bx / 2, By / 2, -Bd, base_vol)
+        b_bot = _gmsh.faces_in(-bx / 2, -by / 2, gap, bx / 2, by / 2, gap, block_vol)
+        b_top = _gmsh.faces_in(-bx / 2, -by / 2, gap + bh, bx / 2, by / 2, gap + bh, block_vol)
         translate = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, gap, 0, 0, 0, 1]
         gmsh.model.mesh.setPeriodic(2, b_bot, patch, translate)
 
@@ -145,33 +145,3 @@ def _nonneg_gap(gap):
     if gap == 0:
         return 0.0
     return _check.positive("gap", gap)
-
-
-def _entities_in(dim, box, owners):
-    """Tags of ``dim``-entities inside the bounding box (with a tiny tolerance) that bound
-    one of the ``owners`` volumes (so coincident faces of the other body are excluded)."""
-    import gmsh
-    eps = _tolerance(box)
-    lo, hi = [v - eps for v in box[:3]], [v + eps for v in box[3:]]
-    found = [t for _, t in gmsh.model.getEntitiesInBoundingBox(*lo, *hi, dim)]
-    own = set()
-    for v in owners:
-        own.update(abs(t) for _, t in gmsh.model.getBoundary([(3, v)], oriented=False))
-    return sorted(t for t in found if t in own)
-
-
-def _tolerance(box):
-    """Search margin (m): OpenCASCADE enlarges bounding boxes by its tolerance (~1e-7 m)."""
-    return 1e-6 * max(1.0, max(abs(v) for v in box)) + 1e-6 * max(box[3] - box[0], box[4] - box[1],
-                                                                    box[5] - box[2])
-
-
-def _faces_in(x0, y0, z0, x1, y1, z1, owners):
-    return _entities_in(2, (x0, y0, z0, x1, y1, z1), owners)
-
-
-def _volumes_in(x0, y0, z0, x1, y1, z1):
-    import gmsh
-    eps = _tolerance((x0, y0, z0, x1, y1, z1))
-    return [t for _, t in gmsh.model.getEntitiesInBoundingBox(x0 - eps, y0 - eps, z0 - eps,
-                                                             x1 + eps, y1 + eps, z1 + eps, 3)]

@@ -24,7 +24,6 @@ import math
 import numpy as np
 
 from . import _check, _gmsh
-from .block_on_base import _faces_in, _volumes_in
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y, UPPER
 
 
@@ -83,21 +82,22 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         occ.fragment([(3, col)], [(2, _quarter_disc(occ, w, z0))])
         occ.synchronize()
 
-        base_vol = _volumes_in(0, 0, -D, Lx, Ly, 0)
-        col_vol = _volumes_in(0, 0, z0, Rc, Rc, z0 + H)
+        base_vol = _gmsh.volumes_in(0, 0, -D, Lx, Ly, 0)
+        col_vol = _gmsh.volumes_in(0, 0, z0, Rc, Rc, z0 + H)
         both = base_vol + col_vol
-        patch_m = _faces_in(0, 0, 0, w, w, 0, base_vol)
-        patch_s = _faces_in(0, 0, z0, w, w, z0, col_vol)
+        patch_m = _gmsh.faces_in(0, 0, 0, w, w, 0, base_vol)
+        patch_s = _gmsh.faces_in(0, 0, z0, w, w, z0, col_vol)
         gmsh.model.mesh.setPeriodic(2, patch_s, patch_m,
                                     [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, z0, 0, 0, 0, 1])
 
         _gmsh.physical(3, base_vol, BASE, NAMES[BASE])
         _gmsh.physical(3, col_vol, UPPER, NAMES[UPPER])
-        _gmsh.physical(2, _faces_in(0, 0, -D, Lx, Ly, -D, base_vol), FIXED, NAMES[FIXED])
-        _gmsh.physical(2, _faces_in(0, 0, z0 + H, Rc, Rc, z0 + H, col_vol), LOADED, NAMES[LOADED])
-        _gmsh.physical(2, _faces_in(0, 0, -D, 0, max(Ly, Rc), z0 + H, both),
+        _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, Lx, Ly, -D, base_vol), FIXED, NAMES[FIXED])
+        _gmsh.physical(2, _gmsh.faces_in(0, 0, z0 + H, Rc, Rc, z0 + H, col_vol), LOADED,
+                       NAMES[LOADED])
+        _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, 0, max(Ly, Rc), z0 + H, both),
                        SYMMETRY_X, NAMES[SYMMETRY_X])
-        _gmsh.physical(2, _faces_in(0, 0, -D, max(Lx, Rc), 0, z0 + H, both),
+        _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, max(Lx, Rc), 0, z0 + H, both),
                        SYMMETRY_Y, NAMES[SYMMETRY_Y])
         _gmsh.physical(2, patch_m, MASTER, NAMES[MASTER])
         _gmsh.physical(2, patch_s, SLAVE, NAMES[SLAVE])

@@ -21,7 +21,6 @@ a periodic copy of the lower body's top face.
 import math
 
 from . import _check, _gmsh
-from .block_on_base import _faces_in, _volumes_in
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y, UPPER
 
 PROGRESSION_2D = 1.15  # ratio of neighbouring interface segments in 2D (any value matches)
@@ -111,17 +110,17 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         lower = occ.addBox(0, 0, -H1, w, w, H1)
         upper = occ.addBox(0, 0, 0, w, w, H2)
         occ.synchronize()
-        lower_vol = _volumes_in(0, 0, -H1, w, w, 0)
-        upper_vol = _volumes_in(0, 0, 0, w, w, H2)
+        lower_vol = _gmsh.volumes_in(0, 0, -H1, w, w, 0)
+        upper_vol = _gmsh.volumes_in(0, 0, 0, w, w, H2)
         if lower_vol != [lower] or upper_vol != [upper]:
             raise RuntimeError(f"gmsh returned unexpected volumes {lower_vol}, {upper_vol}")
         both = lower_vol + upper_vol
-        master = _faces_in(0, 0, 0, w, w, 0, lower_vol)
-        slave = _faces_in(0, 0, 0, w, w, 0, upper_vol)
-        bottom = _faces_in(0, 0, -H1, w, w, -H1, lower_vol)
-        top = _faces_in(0, 0, H2, w, w, H2, upper_vol)
-        sym_x = _faces_in(0, 0, -H1, 0, w, H2, both)
-        sym_y = _faces_in(0, 0, -H1, w, 0, H2, both)
+        master = _gmsh.faces_in(0, 0, 0, w, w, 0, lower_vol)
+        slave = _gmsh.faces_in(0, 0, 0, w, w, 0, upper_vol)
+        bottom = _gmsh.faces_in(0, 0, -H1, w, w, -H1, lower_vol)
+        top = _gmsh.faces_in(0, 0, H2, w, w, H2, upper_vol)
+        sym_x = _gmsh.faces_in(0, 0, -H1, 0, w, H2, both)
+        sym_y = _gmsh.faces_in(0, 0, -H1, w, 0, H2, both)
         identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
         gmsh.model.mesh.setPeriodic(2, slave, master, identity)
 
