@@ -127,8 +127,9 @@ def elasticity_form(u, v, materials, dx=None, kind="plane_strain", cell_tags=Non
 def _check_tags_covered(cell_tags, materials):
     """Raise ValueError on every rank if some cell tag of the mesh has no material."""
     import numpy as np
+    from flexcontact import compat
     local = set(int(t) for t in np.unique(cell_tags.values))
-    comm = cell_tags.mesh.comm
+    comm = compat.tags_comm(cell_tags)
     present = set().union(*comm.allgather(local))
     missing = sorted(present - set(materials))
     if missing:
@@ -145,9 +146,10 @@ def lame_fields(msh, cell_tags, materials, kind="3d"):
     """
     import numpy as np
     import dolfinx.fem as fem
+    from flexcontact import compat
     check_kind(kind)
     _check_tags_covered(cell_tags, materials)
-    V0 = fem.functionspace(msh, ("DG", 0)) if hasattr(fem, "functionspace") else fem.FunctionSpace(msh, ("DG", 0))
+    V0 = compat.scalar_space(msh, "DG", 0)
     mu, lmbda = fem.Function(V0, name="mu_Pa"), fem.Function(V0, name="lambda_Pa")
     tdim = msh.topology.dim
     n_local = msh.topology.index_map(tdim).size_local + msh.topology.index_map(tdim).num_ghosts
@@ -155,7 +157,7 @@ def lame_fields(msh, cell_tags, materials, kind="3d"):
     for tag, m in materials.items():
         cells = cell_tags.indices[cell_tags.values == tag]
         seen[cells] = True
-        dofs = V0.dofmap.list.array.reshape(-1)  # DG0: one dof per cell, cell order
+        dofs = compat.cell_dofs(V0).reshape(-1)  # DG0: one dof per cell, cell order
         mu.x.array[dofs[cells]] = m.mu_Pa
         lmbda.x.array[dofs[cells]] = m.lmbda_Pa
     n_owned = msh.topology.index_map(tdim).size_local

@@ -9,7 +9,7 @@ def surface_nodes(msh, facet_tags, tag: int) -> np.ndarray:
     Collective. Every rank returns the same array, one row per distinct vertex (global
     vertex number), sorted by that number. Meant for checks on small surfaces.
     """
-    import dolfinx.cpp.mesh as cmesh
+    from flexcontact import compat
     tdim = msh.topology.dim
     msh.topology.create_connectivity(tdim - 1, 0)
     f2v = msh.topology.connectivity(tdim - 1, 0)
@@ -18,8 +18,7 @@ def surface_nodes(msh, facet_tags, tag: int) -> np.ndarray:
         np.empty(0, dtype=np.int32)
     verts = verts.astype(np.int32)
     # Vertex -> geometry node (identical for P1 meshes, but not guaranteed in general).
-    cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))  # 0.9 / 0.5 spelling
-    nodes = cmesh.entities_to_geometry(cpp_mesh, 0, verts, False).reshape(-1) if len(verts) else \
+    nodes = compat.entities_to_geometry(msh, 0, verts).reshape(-1) if len(verts) else \
         np.empty(0, dtype=np.int32)
     x = msh.geometry.x[nodes]
     gid = msh.topology.index_map(0).local_to_global(verts) if len(verts) else np.empty(0, np.int64)

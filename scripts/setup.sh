@@ -1,29 +1,51 @@
 #!/usr/bin/env bash
 # Install the Debian packages flexcontact needs (only those missing), build the kernel, its
 # tests and the Python module, and make the package importable by /usr/bin/python3.
+# Runs on Debian 12 (DOLFINx 0.5) and Debian 13 (DOLFINx 0.9; see scripts/debian13.sh); each
+# builds in its own folder, build/<codename>.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
+codename=$(. /etc/os-release && echo "${VERSION_CODENAME:-unknown}")
+build="$here/build/$codename"
 
 packages=(
   cmake g++ make pkg-config python3-dev libblas-dev
   python3-dolfinx libdolfinx-dev petsc-dev python3-petsc4py python3-mpi4py openmpi-bin
-  gmsh python3-gmsh libeigen3-dev pybind11-dev python3-pybind11
+  gmsh python3-gmsh libeigen3-dev pybind11-dev
   googletest libgtest-dev python3-pytest python3-scipy python3-matplotlib python3-tqdm
-  python3-siconos libopenblas0-serial
+  libopenblas0-serial
 )
+# Peer codes used as oracles by some tests; a distribution without them (Debian 13 has no
+# Siconos) skips those tests and says so.
+optional=(python3-siconos)
+
+installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
+available() { apt-cache policy "$1" 2>/dev/null | grep -q 'Candidate: [^(]'; }
+
+SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+for p in "${packages[@]}"; do installed "$p" || missing+=("$p"); done
+updated=0
+if [ ${#missing[@]} -gt 0 ]; then
+  $SUDO apt-get update -qq
+  updated=1
+fi
+for p in "${optional[@]}"; do
+  installed "$p" && continue
+  # Known lists say whether this distribution has it; without lists, ask the archive once.
+  if [ $updated -eq 0 ] && ! available "$p" && [ -z "$(ls /var/lib/apt/lists/ 2>/dev/null | grep -v lock)" ]; then
+    $SUDO apt-get update -qq
+    updated=1
+  fi
+  if available "$p"; then missing+=("$p"); else echo "Not in this distribution's archive: $p"; fi
 done
 if [ ${#missing[@]} -gt 0 ]; then
   echo "Installing Debian packages: ${missing[*]}"
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
 
-cmake -S "$here" -B "$here/build" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
-cmake --build "$here/build" -j "$(nproc)"
+cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build "$build" -j "$(nproc)"
 
 # Make `import flexcontact` work for /usr/bin/python3 from anywhere (like an editable install).
 site=$(/usr/bin/python3 -c "import site; print(site.getsitepackages()[0])")

@@ -27,6 +27,8 @@ try:
 except ImportError:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "dolfinx_ext" / "python"))
     import flexcontact._cpp as fc
+from flexcontact import compat
+from flexcontact.surface import surface_nodes
 
 TOP, RIGHT = 3, 5
 
@@ -40,7 +42,7 @@ def elasticity(n, dim, clamped=True, E=1.0e3, nu=0.3):
     else:
         msh = dolfinx.mesh.create_box(comm, [np.zeros(3), np.ones(3)], [n, n, n],
                                       dolfinx.mesh.CellType.tetrahedron)
-    V = dolfinx.fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
 
@@ -80,7 +82,7 @@ def dense(K):
 
 
 def contact_dofs(V, tags, value=TOP):
-    s = fc.surface_nodes(V, tags, value)
+    s = surface_nodes(V, tags, value)
     root = V.mesh.comm.rank == 0
     return s, (s["dofs"].reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
 

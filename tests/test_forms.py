@@ -12,11 +12,8 @@ import dolfinx
 import dolfinx.fem.petsc  # noqa: F401  (0.5: submodule import needed)
 from dolfinx import fem, mesh
 
-try:
-    import flexcontact.forms as forms
-except ImportError:  # package not built/installed: use the source tree
-    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    import forms
+import flexcontact.forms as forms
+from flexcontact import compat
 
 Material = forms.Material
 STEEL = Material(210e9, 0.3, 7850.0, name="steel")
@@ -82,7 +79,7 @@ def test_material_lame_constants():
 def test_uniaxial_stress_patch_plane_stress():
     """Unit square pulled in x, free lateral contraction: σ_xx = E ε, all else zero."""
     msh = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4, mesh.CellType.triangle)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     eps0 = 1e-3
     bcs = [_fix(V, 0, lambda x: np.isclose(x[0], 0.0), 0.0),
@@ -113,7 +110,7 @@ def test_oedometer_plane_strain_equals_3d():
     for kind, msh in [("plane_strain", mesh.create_unit_square(MPI.COMM_WORLD, 3, 3)),
                       ("3d", mesh.create_unit_cube(MPI.COMM_WORLD, 2, 2, 2))]:
         gdim = msh.geometry.dim
-        V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+        V = compat.vector_space(msh)
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
         bcs = [_fix(V, 0, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 0.0),
                _fix(V, 1, lambda x: np.isclose(x[1], 0.0), 0.0),
@@ -134,7 +131,7 @@ def test_oedometer_plane_strain_equals_3d():
 
 def test_max_principal_3d_matches_eigenvalues():
     msh = mesh.create_unit_cube(MPI.COMM_WORLD, 1, 1, 1)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     rng = np.random.default_rng(1)
     for grad in [rng.normal(size=(3, 3)) * 1e-3, np.eye(3) * 1e-3, np.zeros((3, 3))]:
         uh = fem.Function(V)
@@ -151,7 +148,7 @@ def test_max_principal_3d_matches_eigenvalues():
 
 def test_kind_dimension_mismatch():
     msh = mesh.create_unit_square(MPI.COMM_WORLD, 1, 1)
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     u = ufl.TrialFunction(V)
     with pytest.raises(ValueError, match="kind='3d'"):
         forms.sigma(u, STEEL, "3d")
@@ -173,7 +170,7 @@ def _two_material_square():
 
 def test_elasticity_form_two_materials_energy():
     msh, ct = _two_material_square()
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     mats = {1: Material(1e9, 0.25, name="soft"), 2: Material(3e9, 0.1, name="stiff")}
     grad = np.array([[1e-3, 2e-4], [-1e-4, 5e-4]])
     uh = fem.Function(V)
@@ -197,7 +194,7 @@ def test_elasticity_form_two_materials_energy():
 
 def test_elasticity_form_missing_material():
     msh, ct = _two_material_square()
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     with pytest.raises(ValueError, match=r"cell tags \[2\]"):
         forms.elasticity_form(u, v, {1: STEEL}, kind="plane_strain", cell_tags=ct)
@@ -218,7 +215,7 @@ def _resultant(L, V):
 
 def test_loads_resultants():
     msh = mesh.create_rectangle(MPI.COMM_WORLD, [[0, 0], [2, 1]], [8, 4])
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     v = ufl.TestFunction(V)
     concrete = Material(30e9, 0.2, 2400.0, name="concrete")
     fy = _resultant(forms.gravity(v, concrete, ufl.dx), V)
@@ -237,7 +234,7 @@ def test_loads_resultants():
 
 def test_mass_form_total_mass():
     msh, ct = _two_material_square()
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_space(msh)
     one = fem.Function(V)
     one.interpolate(lambda x: np.vstack([np.ones(x.shape[1]), np.zeros(x.shape[1])]))
     mats = {1: Material(1e9, 0.2, 1000.0), 2: Material(1e9, 0.2, 3000.0)}

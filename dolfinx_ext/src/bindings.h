@@ -8,8 +8,8 @@
 
 namespace flexcontact
 {
-/// @brief flexibility, surface_nodes, set_nodal_values and their exceptions.
-void bind_dolfinx(pybind11::module& m);
+/// @brief The flexibility F* from one MUMPS factorization, and the PETSc/MUMPS exceptions.
+void bind_petsc(pybind11::module& m);
 
 /// @brief The kernel: pairs, frames, gap operator, W, local solvers, incremental driver.
 void bind_kernel(pybind11::module& m);

@@ -5,13 +5,23 @@ The rest of the package calls these helpers only, so that a port is a change in 
 """
 from __future__ import annotations
 
+import numpy as np
+
 import dolfinx
 import dolfinx.fem
 import dolfinx.fem.petsc  # noqa: F401  (submodule must be imported explicitly in 0.5)
 import dolfinx.io
+import dolfinx.mesh
 
-_VERSION = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
-NEW_API = _VERSION >= (0, 8)
+SUPPORTED = ((0, 5), (0, 9))
+"""The DOLFINx generations flexcontact runs on: Debian 12's 0.5 and Debian 13's 0.9."""
+
+VERSION = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
+if VERSION not in SUPPORTED:
+    raise ImportError(
+        f"flexcontact supports DOLFINx 0.5 and 0.9; this Python sees DOLFINx "
+        f"{dolfinx.__version__} ({dolfinx.__file__})")
+NEW_API = VERSION >= (0, 8)
 
 
 def cpp(obj):
@@ -53,6 +63,67 @@ def interpolate_expression(target, expr):
 def geometry_x(msh):
     """Geometry node coordinates, shape (num_nodes, 3)."""
     return msh.geometry.x
+
+
+def geometry_dofmap(msh) -> np.ndarray:
+    """Geometry nodes of each cell, shape (num_cells, nodes per cell), local numbers."""
+    g = msh.geometry.dofmap
+    return g if NEW_API else g.array.reshape(-1, g.offsets[1] - g.offsets[0])
+
+
+def cell_dofs(V) -> np.ndarray:
+    """DOF blocks of each cell, shape (num_cells, blocks per cell), local numbers."""
+    d = V.dofmap.list
+    return d if NEW_API else d.array.reshape(-1, d.offsets[1] - d.offsets[0])
+
+
+def connectivity(msh, d0: int, d1: int):
+    """(array, offsets) of the connectivity d0 → d1, created if missing."""
+    msh.topology.create_connectivity(d0, d1)
+    c = msh.topology.connectivity(d0, d1)
+    return np.asarray(c.array), np.asarray(c.offsets)
+
+
+def entities_to_geometry(msh, dim: int, entities) -> np.ndarray:
+    """Geometry nodes of each entity, shape (len(entities), nodes per entity)."""
+    if NEW_API:
+        return dolfinx.mesh.entities_to_geometry(msh, dim, entities)
+    import dolfinx.cpp.mesh
+    cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))
+    return dolfinx.cpp.mesh.entities_to_geometry(cpp_mesh, dim, entities, False)
+
+
+def cell_vertex_count(msh) -> int:
+    """Vertices of one cell (single cell type meshes)."""
+    arr, off = connectivity(msh, msh.topology.dim, 0)
+    return int(off[1] - off[0])
+
+
+def reference_facet_vertices(msh) -> np.ndarray:
+    """Cell-local vertex numbers of each facet of the reference cell, (facets, nv): the
+    order DOLFINx uses for cell geometry nodes and P1 DOFs alike."""
+    import basix
+    cell = getattr(basix.CellType, msh.topology.cell_type.name)
+    return np.array(basix.topology(cell)[msh.topology.dim - 1], dtype=np.int64)
+
+
+def tags_on_mesh(tags, msh) -> bool:
+    """True if the MeshTags were made on this mesh."""
+    if NEW_API:
+        def unwrap(t):
+            return getattr(t, "_cpp_object", t)
+        return unwrap(tags.topology) is unwrap(msh.topology)
+    return tags.mesh.topology is msh.topology
+
+
+def tags_comm(tags):
+    """The communicator of the mesh the MeshTags live on."""
+    return tags.topology.comm if NEW_API else tags.mesh.comm
+
+
+def is_subspace(V) -> bool:
+    """True for a sub-space such as V.sub(0) (not collapsed)."""
+    return len(V.component()) > 0
 
 
 def create_connectivity(msh, d0: int, d1: int):

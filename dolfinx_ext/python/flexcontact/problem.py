@@ -23,6 +23,8 @@ import dolfinx.fem.petsc
 from . import _cpp, compat
 from .pairing import NodePairs, match_nodes
 from .rigid_modes import check_bodies
+from .surface import surface_nodes
+from .writeback import set_nodal_values
 
 STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
 
@@ -152,8 +154,8 @@ class ContactProblem:
         parts, error = [], None
         mus = []
         for itf in self.interfaces:
-            s = _cpp.surface_nodes(self.V, compat.cpp(itf.facet_tags), itf.slave)
-            m = _cpp.surface_nodes(self.V, compat.cpp(itf.facet_tags), itf.master)
+            s = surface_nodes(self.V, itf.facet_tags, itf.slave)
+            m = surface_nodes(self.V, itf.facet_tags, itf.master)
             if root and error is None:
                 try:
                     tol = itf.tolerance_m
@@ -395,9 +397,9 @@ class ContactProblem:
             pressure = status = np.zeros((0, 1))
             trac = np.zeros((0, d))
             dofs_v = np.zeros((0, d), np.int64)
-        _cpp.set_nodal_values(self.pressure, blocks, pressure)
-        _cpp.set_nodal_values(self.status, blocks, status)
-        _cpp.set_nodal_values(self.traction, dofs_v, trac)
+        set_nodal_values(self.pressure, blocks, pressure)
+        set_nodal_values(self.status, blocks, status)
+        set_nodal_values(self.traction, dofs_v, trac)
         if self.von_mises is not None:
             compat.interpolate_expression(self.von_mises, self._stress_expr)
 
