@@ -120,6 +120,10 @@ if comm.rank == 0:
     summary = {
         "demo": "cattaneo_mindlin", "units": "SI (m, Pa, N/m)", "mu": args.mu,
         "P": P, "Q": Q, "Q_over_muP": Q / (args.mu * P),
+        # The inputs of the references, so that a test can recompute them.
+        "R_m": R, "a_target_m": a_target,
+        "materials": {"block": {"E_Pa": steel.E_Pa, "nu": steel.nu},
+                      "cylinder": {"E_Pa": steel.E_Pa, "nu": steel.nu}},
         "c": c, "c_ref": c_ref, "c_error_rel": c / c_ref - 1,
         "a": a_fit, "a_ref": a_ref, "p0": p0, "p0_ref": p0_ref,
         "shear_rms_error_rel_mu_p0": shear_rms,

@@ -153,6 +153,10 @@ if comm.rank == 0:
         "demo": "hertz3d",
         "units": "SI (m, Pa, N)",
         "P": P, "P_target": P_target, "P_quarter": summaries[-1].normal_force,
+        # The inputs of the references, so that a test can recompute them.
+        "R_m": R, "a_target_m": a_target,
+        "materials": {"block": {"E_Pa": steel.E_Pa, "nu": steel.nu},
+                      "column": {"E_Pa": steel.E_Pa, "nu": steel.nu}},
         "a": a_fit, "a_ref": a_ref, "a_error_rel": a_fit / a_ref - 1,
         "a_extent": a_extent,
         "p0": p0, "p0_ref": p0_ref, "p0_error_rel": p0 / p0_ref - 1,

@@ -107,6 +107,9 @@ if comm.rank == 0:
     umax = max(1e-300, float(np.abs(problem.u.x.array).max()))
     summary = {
         "demo": "sliding_block", "units": "SI (m, N/m)", "mu": args.mu,
+        "normal_increments": n1, "tangential_increments": n2,
+        "materials": {"base": {"E_Pa": steel.E_Pa, "nu": steel.nu},
+                      "block": {"E_Pa": aluminium.E_Pa, "nu": aluminium.nu}},
         "slip_onset_T": T[i0], "slip_onset_T_ref": args.mu * N[i0],
         "slip_onset_error_rel": T[i0] / (args.mu * N[i0]) - 1,
         "slip_onset_push_m": pushes[i0], "slip_onset_increment": i0 + 1,

@@ -221,6 +221,9 @@ if comm.rank == 0:
     summary = {
         "demo": "sliding_block_3d", "units": "SI (m, N, degrees)", "mu": args.mu,
         "turn_deg": args.turn_deg,
+        "normal_increments": n1, "tangential_increments": n2,
+        "materials": {"base": {"E_Pa": steel.E_Pa, "nu": steel.nu},
+                      "block": {"E_Pa": aluminium.E_Pa, "nu": aluminium.nu}},
         "q": T[i0], "q_ref": muN[i0],
         "pad_stiffness_ratio": args.pad_stiffness_ratio, "pad_stiffness_Pa_per_m": k_pad,
         "pad_force_N": np.array(pad), "pad_vs_friction_rel": pad_vs_friction,
