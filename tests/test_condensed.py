@@ -82,6 +82,23 @@ def test_one_call_equals_the_low_level_kernel(dim):
         assert out["report"]["converged"] and out["report"]["solver"] == rep.solver
 
 
+def test_new_flexibility_and_new_pairs():
+    F, X, normals, mu, rng = _random_case(3, 3, seed=9)
+    pairs = _cpp.pairs_from_normals(np.arange(3), np.arange(3, 6)[:, None],
+                                    np.ones((3, 1)), normals)
+    c = _cpp.CondensedContact(3, F, X, pairs, mu)
+    W = c.W
+    c.step(2e-3 * rng.standard_normal(F.shape[0]))
+    q = c.last_q
+    before = c.local_q(q)
+    c.set_flexibility(2.0 * F)  # e.g. another time step: history kept
+    assert np.allclose(c.W, 2.0 * W, rtol=0, atol=1e-14 * np.abs(W).max())
+    assert np.array_equal(c.local_q(q), before)
+    c.set_pairs(c.contact_pairs, 0.5 * mu)  # re-paired: slip measured from the current gap
+    assert np.allclose(c.local_q(q), before, rtol=0, atol=1e-15)
+    assert np.array_equal(c.mu, 0.5 * mu)
+
+
 def test_bad_arguments_name_what_is_wrong():
     F, X, normals, mu, _ = _random_case(2, 2, seed=5)
     pairs = _cpp.pairs_from_normals(np.arange(2), np.arange(2, 4)[:, None],
