@@ -135,13 +135,19 @@ class ContactProblem:
             except ConvergenceError as e:
                 failure = (f"increment {number}: {e}", dict(getattr(e, "report", {})))
                 q = np.asarray(self.contact.local_q(self.contact.last_q))
+            except ValueError as e:
+                # e.g. a non-finite u_p: raised on every rank, not left to hang the others
+                failure, q = (f"increment {number}: {e}", None), None
             # The increment's local problem u = W λ + q' (slip measured from the last gap),
             # kept for inspection and for cross-checks with other solvers.
-            self.local_problem = {"dim": self.dim, "W": self.W, "q": q, "mu": self.mu}
+            if q is not None:
+                self.local_problem = {"dim": self.dim, "W": self.W, "q": q, "mu": self.mu}
         failure = self.comm.bcast(failure, root=0)
         if failure:
             for v in (p, up):
                 v.destroy()
+            if failure[1] is None:
+                raise ValueError(failure[0])
             error = ConvergenceError(failure[0])
             error.report = failure[1]  # what the solvers did, on every rank
             raise error
