@@ -372,4 +372,6 @@ void flexcontact::bind_kernel(py::module& m)
       .def("pairs", &IncrementalSolver::pairs)
       .def("dim", &IncrementalSolver::dim)
       .def_property_readonly("W", [](const IncrementalSolver& s) { return s.W(); });
+
+  bind_condensed(m);
 }

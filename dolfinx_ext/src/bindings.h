@@ -13,4 +13,7 @@ void bind_petsc(pybind11::module& m);
 
 /// @brief The kernel: pairs, frames, gap operator, W, local solvers, incremental driver.
 void bind_kernel(pybind11::module& m);
+
+/// @brief The condensed contact problem (called by bind_kernel, after ConvergenceError).
+void bind_condensed(pybind11::module& m);
 } // namespace flexcontact

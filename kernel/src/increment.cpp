@@ -21,6 +21,17 @@ std::string num(double v)
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
+
+/// @brief Throws naming the first non-finite entry of W and its pair.
+void check_finite(const std::string& who, const Matrix& W, int dim)
+{
+  for (Eigen::Index j = 0; j < W.cols(); ++j)
+    for (Eigen::Index i = 0; i < W.rows(); ++i)
+      if (!std::isfinite(W(i, j)))
+        throw std::invalid_argument(who + "W(" + std::to_string(i) + ", " + std::to_string(j)
+                                    + ") is " + num(W(i, j)) + " (pair "
+                                    + std::to_string(i / dim) + "); W must be finite");
+}
 } // namespace
 
 IncrementalSolver::IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions options)
@@ -42,12 +53,7 @@ IncrementalSolver::IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions
     if (!std::isfinite(mu_[k]) || mu_[k] < 0.0)
       throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
                                   + " is " + num(mu_[k]) + "; it must be finite and >= 0");
-  for (Eigen::Index j = 0; j < W_.cols(); ++j)
-    for (Eigen::Index i = 0; i < W_.rows(); ++i)
-      if (!std::isfinite(W_(i, j)))
-        throw std::invalid_argument(who + "W(" + std::to_string(i) + ", " + std::to_string(j)
-                                    + ") is " + num(W_(i, j)) + " (pair "
-                                    + std::to_string(i / dim_) + "); W must be finite");
+  check_finite(who, W_, dim_);
   if (options_.max_iterations < 1)
     throw std::invalid_argument(who + "max_iterations is "
                                 + std::to_string(options_.max_iterations)
@@ -80,6 +86,17 @@ void IncrementalSolver::set_initial_gap(const Eigen::Ref<const Vector>& x0)
       throw std::invalid_argument(who + "x0[" + std::to_string(i) + "] (pair "
                                   + std::to_string(i / dim_) + ") is " + num(x0[i]));
   x_ = x0;
+}
+
+void IncrementalSolver::set_delassus(Matrix W)
+{
+  const std::string who = "flexcontact: IncrementalSolver::set_delassus: ";
+  if (W.rows() != W_.rows() || W.cols() != W_.cols())
+    throw std::invalid_argument(who + "W is " + std::to_string(W.rows()) + "x"
+                                + std::to_string(W.cols()) + ", expected "
+                                + std::to_string(W_.rows()) + "x" + std::to_string(W_.cols()));
+  check_finite(who, W, dim_);
+  W_ = std::move(W);
 }
 
 Vector IncrementalSolver::local_q(const Eigen::Ref<const Vector>& q_total) const

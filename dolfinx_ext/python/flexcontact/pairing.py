@@ -1,6 +1,7 @@
 """Node–node pairing of two contact surfaces (the seed's first contact model).
 
-Runs on rank 0 with the gathered surface data of ``_cpp.surface_nodes``. Each slave node is
+``match_nodes`` runs on rank 0 with the gathered surface data of ``surface_nodes``;
+``pair_interfaces`` does it for every interface of a problem. Each slave node is
 paired with the master node at the same tangential position (the mesh must have matching
 interface nodes); the local frame comes from the master's outward normal, so the normal gap
 of a pair is n · (X_s − X_m) ≥ 0 when the bodies are apart.
@@ -8,8 +9,12 @@ of a pair is n · (X_s − X_m) ≥ 0 when the bodies are apart.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional, Sequence
 
 import numpy as np
+
+from . import compat
+from .surface import surface_nodes
 
 
 @dataclass
@@ -80,4 +85,52 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
         normal=normals[partner],
         area=np.asarray(slave["area"], dtype=float),
         area_master=np.asarray(master["area"], dtype=float)[partner],
+    )
+
+
+def pair_interfaces(V, interfaces: Sequence, comm) -> tuple[Optional[NodePairs], np.ndarray, int]:
+    """Pairs of all contact interfaces in one node-major numbering.
+
+    Each interface gives ``facet_tags``, ``slave``, ``master``, ``mu``, ``tolerance_m`` (None:
+    1e-6 of the surfaces' extent) and ``label``. Returns (pairs, μ per pair) on rank 0,
+    (None, empty) elsewhere, and the pair count m on every rank. A pairing error is raised
+    as ValueError on every rank.
+    """
+    msh = V.mesh
+    compat.create_connectivity(msh, msh.topology.dim - 1, msh.topology.dim)
+    root = comm.rank == 0
+    parts, mus, error = [], [], None
+    for itf in interfaces:
+        # Collective: every rank takes part even after an error on rank 0.
+        s = surface_nodes(V, itf.facet_tags, itf.slave)
+        m = surface_nodes(V, itf.facet_tags, itf.master)
+        if root and error is None:
+            try:
+                tol = itf.tolerance_m
+                if tol is None:
+                    pts = np.vstack([s["x"], m["x"]])
+                    tol = 1e-6 * max(float(np.ptp(pts, axis=0).max()), 1e-300)
+                parts.append(match_nodes(s, m, tol, itf.label))
+                mus.append(np.full(parts[-1].m, float(itf.mu)))
+            except ValueError as e:
+                error = str(e)
+    error = comm.bcast(error, root=0)
+    if error:
+        raise ValueError(error)
+    pairs = concat(parts) if root else None
+    mu = np.concatenate(mus) if root else np.zeros(0)
+    return pairs, mu, comm.bcast(pairs.m if root else None, root=0)
+
+
+def concat(parts: list[NodePairs]) -> NodePairs:
+    """Pairs of several interfaces in one node-major numbering: all slaves, then all
+    masters in the same order."""
+    if len(parts) == 1:
+        return parts[0]
+    return NodePairs(
+        x=np.vstack([p.x[:p.m] for p in parts] + [p.x[p.m:] for p in parts]),
+        dofs=np.vstack([p.dofs[:p.m] for p in parts] + [p.dofs[p.m:] for p in parts]),
+        normal=np.vstack([p.normal for p in parts]),
+        area=np.concatenate([p.area for p in parts]),
+        area_master=np.concatenate([p.area_master for p in parts]),
     )

@@ -31,6 +31,11 @@ public:
   /// @throws std::invalid_argument on a wrong size or non-finite values
   void set_initial_gap(const Eigen::Ref<const Vector>& x0);
 
+  /// @brief Replace W (same size), e.g. after a change of time step; the history (gap, λ,
+  /// states) is kept and warm-starts the next increment.
+  /// @throws std::invalid_argument on a wrong size or non-finite entries
+  void set_delassus(Matrix W);
+
   /// @brief q' of the local problem u = W λ + q' that step(q_total) solves next: q_total
   /// with the last increment's tangential gap removed (sizes as for step()).
   Vector local_q(const Eigen::Ref<const Vector>& q_total) const;

@@ -1,0 +1,40 @@
+"""Assembly of the stiffness K and the load vector p by DOLFINx (PETSc objects)."""
+from __future__ import annotations
+
+from typing import Optional, Sequence
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+
+from . import compat
+
+
+def assemble_stiffness(a_form, bcs: Sequence) -> PETSc.Mat:
+    """K with the Dirichlet rows and columns replaced by the identity."""
+    K = dolfinx.fem.petsc.assemble_matrix(a_form, bcs=list(bcs))
+    K.assemble()
+    return K
+
+
+def assemble_load(V, a_form, L_form: Optional[object], bcs: Sequence, comm) -> PETSc.Vec:
+    """p with the Dirichlet values of this increment lifted and set.
+
+    Raises ValueError on every rank if any entry is not finite.
+    """
+    # Ghosted, as DOLFINx's lifting and ghost accumulation need.
+    p = compat.create_petsc_vector(V)
+    p.zeroEntries()
+    if L_form is not None:
+        dolfinx.fem.petsc.assemble_vector(p, L_form)
+    dolfinx.fem.petsc.apply_lifting(p, [a_form], bcs=[list(bcs)])
+    p.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    dolfinx.fem.petsc.set_bc(p, list(bcs))
+    if not comm.allreduce(bool(np.all(np.isfinite(p.array_r))), op=MPI.LAND):
+        p.destroy()
+        raise ValueError("the load vector is not finite (check the loads and Dirichlet "
+                         "values of this increment)")
+    return p

@@ -1,0 +1,94 @@
+"""Condensation on the contact DOFs: F* = (K⁻¹)_cc, the scatter of contact values between
+the distributed vectors and rank 0, and the kernel's condensed problem (DESIGN.md §1).
+
+The method's algebra (B, x0, W = B F* Bᵀ, q = B u_p + x0, the contact solve, r_c = Bᵀ λ and
+the totals) lives in the kernel object ``_cpp.CondensedContact`` on rank 0, so that an
+increment crosses the binding once.
+"""
+from __future__ import annotations
+
+import time
+from typing import Optional, Sequence
+
+import numpy as np
+from petsc4py import PETSc
+
+import dolfinx.fem.petsc
+
+from . import _cpp
+from .pairing import NodePairs
+
+
+class Condensation:
+    """F*, its factor and the condensed contact problem of fixed pairs.
+
+    Parameters
+    ----------
+    K : assembled stiffness (Dirichlet rows are identity rows).
+    bcs : the Dirichlet conditions; contact DOFs they hold get no flexibility and no
+        contact reaction.
+    pairs, mu : the node pairs and their friction coefficients (rank 0; None elsewhere).
+    dim : 2 or 3.
+    options : kernel SolverOptions.
+    method : how F* is computed (see ``_cpp.flexibility``).
+
+    On rank 0 ``contact`` is the kernel object and ``B``, ``W``, ``x0``, ``frames`` its
+    operators as SciPy/NumPy arrays; elsewhere they are None.
+    """
+
+    def __init__(self, K: PETSc.Mat, bcs: Sequence, pairs: Optional[NodePairs],
+                 mu: np.ndarray, dim: int, comm, options, method: str):
+        self.comm = comm
+        root = comm.rank == 0
+        self.dofs = (pairs.dofs.reshape(-1).astype(np.int64) if root
+                     else np.zeros(0, np.int64))
+        is_from = PETSc.IS().createGeneral(self.dofs.astype(PETSc.IntType), comm=comm)
+        self._seq = PETSc.Vec().createSeq(self.dofs.size, comm=PETSc.COMM_SELF)
+        is_to = PETSc.IS().createStride(self.dofs.size, 0, 1, comm=PETSc.COMM_SELF)
+        self._scatter = PETSc.Scatter().create(K.createVecLeft(), is_from, self._seq, is_to)
+        self._template = K
+        constrained = self._constrained_mask(K, bcs)
+
+        self.timings = {}
+        t0 = time.perf_counter()
+        F, self.factor, info = _cpp.flexibility(K, self.dofs, method)
+        self.timings["flexibility_s"] = time.perf_counter() - t0
+        self.flex_info = dict(info)
+        self.n_contact_dofs = comm.bcast(self.dofs.size if root else None, root=0)
+
+        self.contact = self.B = self.W = self.x0 = self.frames = None
+        if root:
+            m = pairs.m
+            # Node k < m is the slave of pair k, node m + k its master (NodePairs' numbering).
+            kpairs = _cpp.pairs_from_normals(np.arange(m), np.arange(m, 2 * m)[:, None],
+                                             np.ones((m, 1)), pairs.normal)
+            t0 = time.perf_counter()
+            self.contact = _cpp.CondensedContact(dim, F, pairs.x, kpairs, mu, constrained,
+                                                 options)
+            self.timings["delassus_s"] = time.perf_counter() - t0
+            c = self.contact
+            self.B, self.W, self.x0, self.frames = c.B, c.W, c.x0, c.frames
+
+    def _constrained_mask(self, K: PETSc.Mat, bcs: Sequence) -> Optional[np.ndarray]:
+        """True for the contact DOFs that a Dirichlet condition fixes (rank 0)."""
+        marker = K.createVecLeft()
+        marker.set(1.0)
+        dolfinx.fem.petsc.set_bc(marker, list(bcs), scale=0.0)
+        vals = self.gather(marker)
+        marker.destroy()
+        return vals == 0.0 if vals is not None else None
+
+    def gather(self, vec: PETSc.Vec) -> Optional[np.ndarray]:
+        """The contact-DOF values of a distributed vector, node-major, on rank 0."""
+        self._scatter.scatter(vec, self._seq, addv=PETSc.InsertMode.INSERT,
+                              mode=PETSc.ScatterMode.FORWARD)
+        return self._seq.array.copy() if self.comm.rank == 0 else None
+
+    def reaction(self, r_c: Optional[np.ndarray]) -> PETSc.Vec:
+        """The contact forces r = Bᵀ λ as a distributed vector (r_c given on rank 0)."""
+        r = self._template.createVecLeft()
+        r.zeroEntries()
+        if self.comm.rank == 0:
+            r.setValues(self.dofs.astype(PETSc.IntType), r_c, addv=PETSc.InsertMode.ADD_VALUES)
+        r.assemble()
+        return r

@@ -1,0 +1,149 @@
+"""What an increment produced: its summary, its contact data, and the contact fields
+(pressure, tangential traction, status, stress) written back into DOLFINx Functions.
+
+Everything here reads the dict that the kernel's ``CondensedContact.step`` returned; none of
+the method's algebra is redone in NumPy.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+from mpi4py import MPI
+
+import dolfinx.fem
+
+from . import compat
+from .writeback import set_nodal_values
+from .pairing import NodePairs
+
+STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
+
+
+@dataclass
+class IncrementSummary:
+    """What one increment produced; forces per unit thickness in 2D [N/m], in N in 3D.
+
+    ``tangential_force`` is the total friction force on the slave surface in global axes
+    (x, y in 2D; x, y, z in 3D).
+    """
+
+    increment: int
+    normal_force: float
+    tangential_force: list
+    stick: int
+    slip: int
+    open: int
+    max_penetration_m: float
+    max_penetration_rel: float
+    residual: float
+    iterations: int
+    state_changes: int
+    solver: str
+    time_s: float
+
+    def line(self) -> str:
+        t = np.linalg.norm(self.tangential_force)
+        return (f"increment {self.increment:3d}: N = {self.normal_force:11.4e}  "
+                f"|T| = {t:11.4e}  stick/slip/open = {self.stick}/{self.slip}/{self.open}  "
+                f"penetration = {self.max_penetration_rel:8.1e}  residual = {self.residual:8.1e}"
+                f"  {self.solver} ({self.iterations} it)")
+
+
+@dataclass
+class IncrementResult:
+    """Contact data of one increment, on rank 0 (empty arrays elsewhere)."""
+
+    summary: IncrementSummary
+    lam: np.ndarray        # (m, d) λ in the local frame (λ_n ≥ 0 compression) [N or N/m]
+    gap: np.ndarray        # (m, d) total gap x in the local frame [m]
+    states: np.ndarray     # (m,) 0 open, 1 stick, 2 slip
+    slip_increment: np.ndarray  # (m, d-1) tangential slip in this increment [m]
+    tangential: Optional[np.ndarray] = None  # (m, d) friction force per pair, global axes
+
+
+def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
+                     elapsed: float) -> IncrementResult:
+    """IncrementResult from the kernel's step dict ``out`` (rank 0; None elsewhere). The
+    summary is broadcast; the penetration is also given relative to max |u|."""
+    root = comm.rank == 0
+    umax = comm.allreduce(float(np.max(np.abs(u.x.array), initial=0.0)), op=MPI.MAX)
+    summary = None
+    if root:
+        rep = out["report"]
+        states = out["states"].astype(int)
+        pen = float(out["max_penetration"])
+        summary = IncrementSummary(
+            increment=number,
+            normal_force=float(out["normal_force"]),
+            tangential_force=out["tangential_force"].tolist(),
+            stick=int((states == 1).sum()), slip=int((states == 2).sum()),
+            open=int((states == 0).sum()),
+            max_penetration_m=pen,
+            max_penetration_rel=pen / umax if umax > 0 else 0.0,
+            residual=float(rep["residual"]), iterations=int(rep["iterations"]),
+            state_changes=int(rep["state_changes"]), solver=str(rep["solver"]),
+            time_s=elapsed)
+    summary = comm.bcast(summary, root=0)
+    if root:
+        return IncrementResult(summary, out["lambda"], out["gap"], states, out["slip"],
+                               out["pair_tangential"])
+    e = np.zeros((0, dim))
+    return IncrementResult(summary, e, e, np.zeros(0, int), e[:, 1:], e)
+
+
+class ContactFields:
+    """The output Functions: displacement, contact pressure, tangential traction, status
+    (1 open, 2 stick, 3 slip) and, if ``stress`` is given (u -> UFL scalar), a DG0 stress."""
+
+    def __init__(self, V, comm, stress: Optional[Callable] = None):
+        msh = V.mesh
+        self.V, self.comm, self.dim = V, comm, msh.geometry.dim
+        self.u = dolfinx.fem.Function(V, name="displacement")
+        Q = compat.scalar_space(msh, "Lagrange", 1)
+        self.pressure = dolfinx.fem.Function(Q, name="contact_pressure")
+        self.traction = dolfinx.fem.Function(V, name="tangential_traction")
+        self.status = dolfinx.fem.Function(Q, name="contact_status")
+        # Scalar fields are written at the vector space's node blocks: the numberings must agree.
+        nQ = Q.dofmap.index_map.size_local
+        nV = V.dofmap.index_map.size_local
+        same = nQ == nV and np.allclose(Q.tabulate_dof_coordinates()[:nQ],
+                                        V.tabulate_dof_coordinates()[:nV])
+        if not comm.allreduce(same, op=MPI.LAND):
+            raise RuntimeError("scalar and vector P1 spaces number their nodes differently; "
+                               "contact fields cannot be written back")
+        self.von_mises = None
+        if stress is not None:
+            self.von_mises = dolfinx.fem.Function(compat.scalar_space(msh, "DG", 0),
+                                                  name="von_mises")
+            self._stress_expr = stress(self.u)
+
+    def write_back(self, inc: IncrementResult, pairs: Optional[NodePairs]) -> None:
+        """Contact fields of an increment at the slave and master nodes (collective)."""
+        d = self.dim
+        if self.comm.rank == 0:
+            blocks = pairs.dofs[:, :1] // d
+            area = np.concatenate([pairs.area, pairs.area_master])
+            lam_n = np.concatenate([inc.lam[:, 0], inc.lam[:, 0]])
+            pressure = (lam_n / area)[:, None]
+            t = inc.tangential
+            # Master nodes carry the reaction: equal and opposite traction.
+            trac = np.vstack([t / pairs.area[:, None], -t / pairs.area_master[:, None]])
+            status = np.concatenate([inc.states, inc.states])[:, None] + 1.0
+            dofs_v = pairs.dofs
+        else:
+            blocks = np.zeros((0, 1), np.int64)
+            pressure = status = np.zeros((0, 1))
+            trac = np.zeros((0, d))
+            dofs_v = np.zeros((0, d), np.int64)
+        set_nodal_values(self.pressure, blocks, pressure)
+        set_nodal_values(self.status, blocks, status)
+        set_nodal_values(self.traction, dofs_v, trac)
+        if self.von_mises is not None:
+            compat.interpolate_expression(self.von_mises, self._stress_expr)
+
+    def all(self) -> list:
+        """The Functions, in the order ResultWriter writes them."""
+        f = [self.u, self.pressure, self.traction, self.status]
+        return f + ([self.von_mises] if self.von_mises is not None else [])

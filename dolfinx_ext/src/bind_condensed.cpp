@@ -1,0 +1,205 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file bind_condensed.cpp
+/// @brief Python binding of the condensed contact problem (kernel/.../condensed.hpp).
+///
+/// An increment crosses the binding once: step() takes NumPy in and hands back a plain dict
+/// of NumPy arrays and numbers, so that the Python side reads no attribute of a C++ object.
+
+#include "bindings.h"
+
+#include <flexcontact/condensed.hpp>
+#include <flexcontact/pairs.hpp>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <optional>
+
+namespace py = pybind11;
+using namespace flexcontact;
+
+namespace
+{
+using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
+using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
+using RealArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// @brief A pair-by-pair vector (m·cols entries) as an m × cols array.
+py::array_t<double> rows_of(const Vector& v, Eigen::Index cols)
+{
+  const Eigen::Index m = cols ? v.size() / cols : 0;
+  py::array_t<double> a({static_cast<py::ssize_t>(m), static_cast<py::ssize_t>(cols)});
+  if (v.size())
+    std::memcpy(a.mutable_data(), v.data(), sizeof(double) * v.size());
+  return a;
+}
+
+py::array_t<int> states_array(const std::vector<PairState>& s)
+{
+  py::array_t<int> a(static_cast<py::ssize_t>(s.size()));
+  for (std::size_t i = 0; i < s.size(); ++i)
+    a.mutable_at(i) = static_cast<int>(s[i]);
+  return a;
+}
+
+/// @brief What a solver did, as plain Python (picklable, so it can be broadcast).
+py::dict report_dict(const SolveReport& r)
+{
+  py::dict d;
+  d["solver"] = r.solver;
+  d["converged"] = r.converged;
+  d["iterations"] = r.iterations;
+  d["state_changes"] = r.state_changes;
+  d["residual"] = r.residual;
+  d["cycled"] = r.cycled;
+  d["attempts"] = r.attempts;
+  return d;
+}
+
+py::dict step_dict(const CondensedStep& r, int dim)
+{
+  py::dict d;
+  d["lambda"] = rows_of(r.lambda, dim);
+  d["gap"] = rows_of(r.gap, dim);
+  d["slip"] = rows_of(r.slip, dim - 1);
+  d["states"] = states_array(r.states);
+  d["reaction"] = py::array_t<double>(r.reaction.size(), r.reaction.data());
+  d["local_q"] = py::array_t<double>(r.local_q.size(), r.local_q.data());
+  d["normal_force"] = r.normal_force;
+  d["tangential_force"] = py::array_t<double>(r.tangential_force.size(),
+                                              r.tangential_force.data());
+  d["max_penetration"] = r.max_penetration;
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> t
+      = r.pair_tangential;
+  d["pair_tangential"] = py::array_t<double>({t.rows(), t.cols()}, t.data());
+  d["report"] = report_dict(r.report);
+  return d;
+}
+
+std::vector<bool> flags(const std::optional<BoolArray>& a)
+{
+  if (!a)
+    return {};
+  return std::vector<bool>(a->data(), a->data() + a->size());
+}
+
+/// @brief Node–node or node–segment pairs with frames from the masters' normals, built in
+/// one call: slave (m), masters (m × j), weights (m × j), normals (m × d).
+std::vector<ContactPair> pairs_from_normals(const IntArray& slave, const IntArray& masters,
+                                            const RealArray& weights, const RealArray& normals)
+{
+  const py::ssize_t m = slave.size();
+  if (masters.ndim() != 2 or weights.ndim() != 2 or normals.ndim() != 2)
+    throw std::invalid_argument("masters, weights and normals must be 2-D arrays");
+  if (masters.shape(0) != m or weights.shape(0) != m or normals.shape(0) != m)
+    throw std::invalid_argument("slave, masters, weights and normals must have one row per "
+                                "pair (" + std::to_string(m) + ")");
+  if (masters.shape(1) != weights.shape(1))
+    throw std::invalid_argument("masters has " + std::to_string(masters.shape(1))
+                                + " columns but weights " + std::to_string(weights.shape(1)));
+  const py::ssize_t j = masters.shape(1), d = normals.shape(1);
+  std::vector<ContactPair> pairs(m);
+  for (py::ssize_t k = 0; k < m; ++k)
+  {
+    ContactPair& p = pairs[k];
+    p.slave = slave.data()[k];
+    p.masters.assign(masters.data() + k * j, masters.data() + (k + 1) * j);
+    p.weights.assign(weights.data() + k * j, weights.data() + (k + 1) * j);
+    p.frame = frame_from_normal(Eigen::Map<const Vector>(normals.data() + k * d, d));
+  }
+  return pairs;
+}
+} // namespace
+
+void flexcontact::bind_condensed(py::module& m)
+{
+  // Registered by bind_kernel; the module keeps it alive.
+  const py::handle convergence_error = m.attr("ConvergenceError");
+
+  m.def("pairs_from_normals", &pairs_from_normals, py::arg("slave"), py::arg("masters"),
+        py::arg("weights"), py::arg("normals"),
+        "ContactPairs with frames from the masters' outward normals, in one call: slave (m), "
+        "masters (m x j), weights (m x j), normals (m x d)");
+
+  py::class_<CondensedContact>(
+      m, "CondensedContact",
+      "The condensed contact problem x = W lambda + q: pairs, B, x0, W = B F* B^T and the "
+      "incremental driver. Contact DOFs are node-major (contact node a owns a*d + c).")
+      .def(py::init(
+               [](int dim, Matrix F, Matrix X, std::vector<ContactPair> pairs, Vector mu,
+                  const std::optional<BoolArray>& constrained, const SolverOptions& options)
+               {
+                 return CondensedContact(dim, std::move(F), std::move(X), std::move(pairs),
+                                         std::move(mu), flags(constrained), options);
+               }),
+           py::arg("dim"), py::arg("F"), py::arg("X"), py::arg("pairs"), py::arg("mu"),
+           py::arg("constrained") = py::none(), py::arg("options") = SolverOptions(),
+           "F (n_c x n_c) flexibility; X (n_nodes x dim) contact node coordinates; mu per "
+           "pair; constrained: n_c flags of Dirichlet-held contact DOFs (None: none)")
+      .def(
+          "step",
+          [convergence_error](CondensedContact& c, const Vector& up_c)
+          {
+            CondensedStep r;
+            try
+            {
+              py::gil_scoped_release release;
+              r = c.step(up_c);
+            }
+            catch (const ConvergenceError& e)
+            {
+              // The report goes along as a plain dict, like step()'s result.
+              py::object error = convergence_error(e.what());
+              error.attr("report") = report_dict(e.report);
+              PyErr_SetObject(convergence_error.ptr(), error.ptr());
+              throw py::error_already_set();
+            }
+            return step_dict(r, c.dim());
+          },
+          py::arg("up_c"),
+          "One increment from the contact-DOF values of u_p = K^-1 p. Returns a dict: lambda, "
+          "gap (m x d, local frames), slip (m x d-1, this increment), states (0 open, 1 "
+          "stick, 2 slip), reaction (n_c, B^T lambda, zero on constrained DOFs), local_q, "
+          "normal_force, tangential_force (d, global), max_penetration, pair_tangential "
+          "(m x d, global), report (dict). Raises ConvergenceError with .report (a dict); the "
+          "history is then unchanged")
+      .def("set_flexibility", &CondensedContact::set_flexibility, py::arg("F"),
+           "New F* (e.g. another time step): W is rebuilt, pairs and history kept")
+      .def("set_pairs", &CondensedContact::set_pairs, py::arg("pairs"), py::arg("mu"),
+           "New pairs: B, x0, W rebuilt from the stored F*; history reset, slip measured from "
+           "the new pairs' gap at the last contact displacement")
+      .def("local_q", &CondensedContact::local_q, py::arg("q"),
+           "q' of the local problem u = W lambda + q' that step solves next for this total q")
+      .def_property_readonly("B", [](const CondensedContact& c)
+                             { return Eigen::SparseMatrix<double, Eigen::RowMajor>(c.B()); },
+                             "Gap operator (scipy CSR, m*d x n_c)")
+      .def_property_readonly("x0", [](const CondensedContact& c) { return c.x0(); })
+      .def_property_readonly("W", [](const CondensedContact& c) { return c.W(); })
+      .def_property_readonly("F", [](const CondensedContact& c) { return c.flexibility(); },
+                             "F* with the constrained DOFs' rows and columns zeroed")
+      .def_property_readonly("mu", [](const CondensedContact& c) { return c.mu(); })
+      .def_property_readonly("last_q", [](const CondensedContact& c) { return c.last_q(); },
+                             "q = B up_c + x0 of the last step call, also a failed one")
+      .def_property_readonly(
+          "frames",
+          [](const CondensedContact& c)
+          {
+            const int d = c.dim();
+            py::array_t<double> a({c.pairs(), d, d});
+            auto v = a.mutable_unchecked<3>();
+            for (int k = 0; k < c.pairs(); ++k)
+              for (int i = 0; i < d; ++i)
+                for (int j = 0; j < d; ++j)
+                  v(k, i, j) = c.contact_pairs()[k].frame(i, j);
+            return a;
+          },
+          "Local frames T_k (m x d x d), rows n, t (, t2)")
+      .def_property_readonly("contact_pairs",
+                             [](const CondensedContact& c) { return c.contact_pairs(); })
+      .def("pairs", &CondensedContact::pairs, "Number of pairs m")
+      .def("contact_dofs", &CondensedContact::contact_dofs, "Number of contact DOFs n_c")
+      .def("dim", &CondensedContact::dim);
+}

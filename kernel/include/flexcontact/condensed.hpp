@@ -1,0 +1,111 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file condensed.hpp
+/// @brief The condensed contact problem x = W λ + q as one object (DESIGN.md §1, §3).
+///
+/// It owns the gap operator B, the initial gap x0, W = B F* Bᵀ and the incremental driver, so
+/// that one increment is one call: the contact-DOF values of u_p = K⁻¹ p go in; λ, the gap,
+/// the states, the contact reaction r_c = Bᵀ λ and the totals come out. Contact DOFs are
+/// node-major (contact node a owns DOFs a·d + c), as in pairs.hpp.
+
+#include "flexcontact/increment.hpp"
+#include "flexcontact/pairs.hpp"
+#include "flexcontact/problem.hpp"
+
+#include <Eigen/Sparse>
+#include <vector>
+
+namespace flexcontact
+{
+/// @brief What one increment of the condensed problem produced. Vectors are pair by pair,
+/// normal first (as λ); "global" means the mesh's x, y (, z) axes.
+struct CondensedStep
+{
+  Vector lambda;                  ///< m·d contact forces in the local frames
+  Vector gap;                     ///< m·d total gap x = W λ + q
+  Vector slip;                    ///< m·(d−1) tangential slip of this increment
+  std::vector<PairState> states;  ///< per pair
+  SolveReport report;             ///< what the local solver did
+  Vector reaction;                ///< n_c, r_c = Bᵀ λ; zero on constrained contact DOFs
+  Vector local_q;                 ///< q' of the local problem u = W λ + q' that was solved
+  double normal_force = 0.0;      ///< Σ_k λ_n,k
+  Vector tangential_force;        ///< d, Σ_k T_kᵀ (0, λ_t,k): the total friction force
+  double max_penetration = 0.0;   ///< max(0, −min_k x_n,k)
+  Matrix pair_tangential;         ///< m × d, T_kᵀ (0, λ_t,k) per pair
+};
+
+/// @brief Pairs, B, x0, W = B F* Bᵀ and the incremental driver of one contact problem.
+///
+/// F* = (K⁻¹)_cc is the flexibility on the n_c contact DOFs. A contact DOF held by a
+/// Dirichlet condition does not move under contact forces: its rows and columns of F* are
+/// zeroed (K's identity row would otherwise give it a flexibility of 1) and its entry of the
+/// reaction r_c is zero, the constraint taking that force.
+class CondensedContact
+{
+public:
+  /// @param dim 2 or 3
+  /// @param Fstar n_c × n_c flexibility, n_c = n_nodes·dim
+  /// @param X n_nodes × dim coordinates of the contact nodes
+  /// @param pairs slave, masters, weights and frame of each pair (indices are contact nodes)
+  /// @param mu friction coefficient per pair
+  /// @param constrained n_c flags of Dirichlet-held contact DOFs, or empty for none
+  /// @throws std::invalid_argument naming the argument whose size or value is wrong
+  CondensedContact(int dim, Matrix Fstar, Matrix X, std::vector<ContactPair> pairs, Vector mu,
+                   std::vector<bool> constrained = {}, SolverOptions options = {});
+
+  /// @brief Solve one increment from the contact-DOF values of u_p = K⁻¹ p (total load).
+  /// @throws std::invalid_argument if up_c has the wrong size or is not finite
+  /// @throws ConvergenceError if a pair with no normal flexibility is pushed into
+  /// penetration (no contact force can open it), or if no solver converges; the history is
+  /// then unchanged
+  CondensedStep step(const Eigen::Ref<const Vector>& up_c);
+
+  /// @brief Replace F* (e.g. K_eff⁻¹ for another time step) and rebuild W. Pairs and history
+  /// (gap, λ, states) are kept: the next increment starts from them.
+  /// @throws std::invalid_argument on a wrong size or non-finite entries
+  void set_flexibility(Matrix Fstar);
+
+  /// @brief Replace the pairs (re-pairing as bodies slide) and rebuild B, x0, W from the
+  /// stored F*. The history is reset: λ = 0, no states. Slip is measured from the new pairs'
+  /// gap at the contact displacement of the last increment, u_c = u_p,c + F* r_c (zero
+  /// before the first one), so that re-pairing does not count as slip.
+  /// @throws std::invalid_argument as the constructor
+  void set_pairs(std::vector<ContactPair> pairs, Vector mu);
+
+  /// @brief q' = q with the last increment's tangential gap removed, as
+  /// IncrementalSolver::local_q: the local problem the next step(up_c) solves for this q.
+  Vector local_q(const Eigen::Ref<const Vector>& q) const { return solver_.local_q(q); }
+
+  /// @brief q = B up_c + x0 of the last step() call, also when it failed (empty before).
+  const Vector& last_q() const { return q_; }
+
+  const Eigen::SparseMatrix<double>& B() const { return B_; } ///< m·d × n_c
+  const Vector& x0() const { return x0_; }                   ///< initial gap, m·d
+  const Matrix& W() const { return solver_.W(); }            ///< B F* Bᵀ, m·d × m·d
+  const Matrix& flexibility() const { return F_; }           ///< F*, constrained DOFs zeroed
+  const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
+  const Vector& mu() const { return mu_; }
+  const IncrementalSolver& solver() const { return solver_; }
+  int dim() const { return dim_; }
+  int pairs() const { return static_cast<int>(pairs_.size()); }
+  int contact_dofs() const { return static_cast<int>(F_.rows()); } ///< n_c
+
+private:
+  /// @brief Message naming held pairs pushed into penetration by q, or empty.
+  std::string held_and_penetrating(const Vector& q) const;
+
+  int dim_;
+  Matrix F_;
+  Matrix X_;
+  std::vector<ContactPair> pairs_;
+  Vector mu_;
+  std::vector<bool> constrained_;
+  SolverOptions options_;
+  Eigen::SparseMatrix<double> B_;
+  Vector x0_;
+  IncrementalSolver solver_;
+  Vector q_;          ///< q of the last step() call
+  Vector u_c_;        ///< contact displacement of the last increment, u_p,c + F* r_c
+};
+} // namespace flexcontact

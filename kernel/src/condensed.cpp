@@ -1,0 +1,204 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file condensed.cpp
+/// @brief The condensed contact problem: B, x0, W = B F* Bᵀ from pairs and F*, and one
+/// increment from u_p on the contact DOFs to λ, gap, states and contact forces.
+
+#include "flexcontact/condensed.hpp"
+#include "python_float.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace flexcontact
+{
+namespace
+{
+const std::string who = "flexcontact: CondensedContact: ";
+
+std::string size_of(const Matrix& A)
+{
+  return std::to_string(A.rows()) + "x" + std::to_string(A.cols());
+}
+
+int checked_dim(int dim)
+{
+  if (dim != 2 && dim != 3)
+    throw std::invalid_argument(who + "dim is " + std::to_string(dim) + "; it must be 2 or 3");
+  return dim;
+}
+
+/// @brief Throws unless F* is n_c × n_c and finite.
+void check_flexibility(const Matrix& F, Eigen::Index n_c)
+{
+  if (F.rows() != n_c || F.cols() != n_c)
+    throw std::invalid_argument(who + "F* is " + size_of(F) + ", expected "
+                                + std::to_string(n_c) + "x" + std::to_string(n_c)
+                                + " (contact nodes × dim)");
+  if (!F.allFinite())
+    throw std::invalid_argument(who + "F* is not finite");
+}
+
+/// @brief Zeroes the rows and columns of F* that belong to constrained contact DOFs.
+void zero_constrained(Matrix& F, const std::vector<bool>& constrained)
+{
+  for (std::size_t i = 0; i < constrained.size(); ++i)
+    if (constrained[i])
+    {
+      F.row(static_cast<Eigen::Index>(i)).setZero();
+      F.col(static_cast<Eigen::Index>(i)).setZero();
+    }
+}
+
+void check_mu(const Vector& mu, std::size_t m)
+{
+  if (static_cast<std::size_t>(mu.size()) != m)
+    throw std::invalid_argument(who + "mu has " + std::to_string(mu.size())
+                                + " entries but there are " + std::to_string(m) + " pairs");
+}
+
+std::string exp3(double v)
+{
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3e", v);
+  return buf;
+}
+} // namespace
+
+CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
+                                   std::vector<ContactPair> pairs, Vector mu,
+                                   std::vector<bool> constrained, SolverOptions options)
+    : dim_(checked_dim(dim)), F_(std::move(Fstar)), X_(std::move(X)), pairs_(std::move(pairs)),
+      mu_(std::move(mu)), constrained_(std::move(constrained)), options_(std::move(options)),
+      solver_(dim_, Matrix(), Vector(), options_)
+{
+  if (X_.cols() != dim_)
+    throw std::invalid_argument(who + "X is " + size_of(X_) + "; it must have dim = "
+                                + std::to_string(dim_) + " columns");
+  if (!X_.allFinite())
+    throw std::invalid_argument(who + "X (contact node coordinates) is not finite");
+  const Eigen::Index n_c = X_.rows() * dim_;
+  check_flexibility(F_, n_c);
+  if (!constrained_.empty() && static_cast<Eigen::Index>(constrained_.size()) != n_c)
+    throw std::invalid_argument(who + "constrained has " + std::to_string(constrained_.size())
+                                + " entries, expected 0 or n_c = " + std::to_string(n_c));
+  check_mu(mu_, pairs_.size());
+  zero_constrained(F_, constrained_);
+  // gap_operator and initial_gap check the pairs against the node count and dimension.
+  B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
+  x0_ = initial_gap(pairs_, X_);
+  solver_ = IncrementalSolver(dim_, delassus(B_, F_), mu_, options_);
+  solver_.set_initial_gap(x0_);
+}
+
+void CondensedContact::set_flexibility(Matrix Fstar)
+{
+  check_flexibility(Fstar, F_.rows());
+  zero_constrained(Fstar, constrained_);
+  solver_.set_delassus(delassus(B_, Fstar));
+  F_ = std::move(Fstar);
+}
+
+void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
+{
+  check_mu(mu, pairs.size());
+  // Built aside first, so that bad pairs leave the object as it was.
+  auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
+  Vector x0 = initial_gap(pairs, X_);
+  IncrementalSolver solver(dim_, delassus(B, F_), mu, options_);
+  solver.set_initial_gap(u_c_.size() ? Vector(B * u_c_ + x0) : x0);
+  B_ = std::move(B);
+  x0_ = std::move(x0);
+  solver_ = std::move(solver);
+  pairs_ = std::move(pairs);
+  mu_ = std::move(mu);
+}
+
+std::string CondensedContact::held_and_penetrating(const Vector& q) const
+{
+  // A pair whose nodes are all held by Dirichlet conditions has no normal flexibility; if
+  // the prescribed motion makes it penetrate, no contact force can open it and the
+  // iterations would only make λ grow.
+  const Matrix& W = solver_.W();
+  const int m = pairs();
+  double wmax = 0.0;
+  for (int k = 0; k < m; ++k)
+    wmax = std::max(wmax, W(k * dim_, k * dim_));
+  const double rigid = 1e-12 * std::max(wmax, 1e-300);
+  const double scale = std::max(q.size() ? q.cwiseAbs().maxCoeff() : 0.0, 1e-300);
+  int count = 0, first = -1;
+  for (int k = 0; k < m; ++k)
+    if (W(k * dim_, k * dim_) <= rigid && q[k * dim_] < -1e-12 * scale)
+    {
+      if (count++ == 0)
+        first = k;
+    }
+  if (count == 0)
+    return "";
+  std::string at = "[";
+  for (int c = 0; c < dim_; ++c)
+    at += (c ? ", " : "") + detail::python_float(X_(pairs_[first].slave, c));
+  at += "]";
+  return std::to_string(count)
+         + " contact pair(s) are held by Dirichlet conditions on both sides and pushed into "
+           "each other, so no contact force can separate them; e.g. the slave node at "
+         + at + " penetrates by " + exp3(-q[first * dim_])
+         + " m. Release one side or change the prescribed displacements";
+}
+
+CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c)
+{
+  if (up_c.size() != F_.rows())
+    throw std::invalid_argument(who + "step: up_c has " + std::to_string(up_c.size())
+                                + " entries, expected n_c = " + std::to_string(F_.rows()));
+  if (!up_c.allFinite())
+    throw std::invalid_argument(who + "step: up_c is not finite");
+  q_ = B_ * up_c + x0_;
+  const std::string held = held_and_penetrating(q_);
+  if (!held.empty())
+  {
+    SolveReport none;
+    none.solver = "none";
+    none.attempts = {"not solved: held pairs pushed into each other"};
+    throw ConvergenceError(held, std::move(none));
+  }
+
+  CondensedStep r;
+  r.local_q = solver_.local_q(q_);
+  const Vector previous = solver_.gap();
+  r.report = solver_.step(q_);
+  r.lambda = solver_.force();
+  r.gap = solver_.gap();
+  r.states = solver_.states();
+
+  const int m = pairs(), d = dim_;
+  r.slip.resize(m * (d - 1));
+  r.pair_tangential = Matrix::Zero(m, d);
+  r.normal_force = 0.0;
+  double min_gap = 0.0;
+  for (int k = 0; k < m; ++k)
+  {
+    r.normal_force += r.lambda[k * d];
+    min_gap = std::min(min_gap, r.gap[k * d]);
+    for (int j = 1; j < d; ++j)
+    {
+      r.slip[k * (d - 1) + j - 1] = r.gap[k * d + j] - previous[k * d + j];
+      // The friction force in global axes: the tangent rows of T_k carry λ_t back.
+      r.pair_tangential.row(k) += r.lambda[k * d + j] * pairs_[k].frame.row(j);
+    }
+  }
+  r.tangential_force = r.pair_tangential.colwise().sum().transpose();
+  r.max_penetration = std::max(0.0, -min_gap);
+
+  r.reaction = B_.transpose() * r.lambda;
+  for (std::size_t i = 0; i < constrained_.size(); ++i)
+    if (constrained_[i])
+      r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+  // Kept for re-pairing: the gap of new pairs at this displacement is their slip origin.
+  u_c_ = up_c + F_ * r.reaction;
+  return r;
+}
+} // namespace flexcontact
