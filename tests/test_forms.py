@@ -25,7 +25,7 @@ def _cell_values(msh, expr):
     pt = np.full((1, tdim), 1.0 / (tdim + 1))
     e = fem.Expression(expr, pt)
     ncell = msh.topology.index_map(tdim).size_local
-    return e.eval(np.arange(ncell, dtype=np.int32)).reshape(ncell, -1)
+    return compat.eval_expression(e, msh, np.arange(ncell, dtype=np.int32)).reshape(ncell, -1)
 
 
 def _solve(a, L, bcs):

@@ -32,7 +32,7 @@ def assemble_load(V, a_form, L_form: Optional[object], bcs: Sequence, comm) -> P
         dolfinx.fem.petsc.assemble_vector(p, L_form)
     dolfinx.fem.petsc.apply_lifting(p, [a_form], bcs=[list(bcs)])
     p.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    dolfinx.fem.petsc.set_bc(p, list(bcs))
+    compat.set_bc(p, list(bcs))
     if not comm.allreduce(bool(np.all(np.isfinite(p.array_r))), op=MPI.LAND):
         p.destroy()
         raise ValueError("the load vector is not finite (check the loads and Dirichlet "

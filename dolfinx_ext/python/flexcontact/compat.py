@@ -60,6 +60,13 @@ def interpolate_expression(target, expr):
     target.interpolate(e)
 
 
+def eval_expression(expr, msh, cells) -> np.ndarray:
+    """Values of a dolfinx.fem.Expression on the given cells, (cells, points · size)."""
+    if NEW_API:
+        return expr.eval(msh, cells)
+    return expr.eval(cells)
+
+
 def geometry_x(msh):
     """Geometry node coordinates, shape (num_nodes, 3)."""
     return msh.geometry.x
@@ -87,10 +94,11 @@ def connectivity(msh, d0: int, d1: int):
 def entities_to_geometry(msh, dim: int, entities) -> np.ndarray:
     """Geometry nodes of each entity, shape (len(entities), nodes per entity)."""
     if NEW_API:
+        msh.topology.create_connectivity(dim, msh.topology.dim)
         return dolfinx.mesh.entities_to_geometry(msh, dim, entities)
-    import dolfinx.cpp.mesh
+    from dolfinx.cpp.mesh import entities_to_geometry as cpp_entities_to_geometry
     cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))
-    return dolfinx.cpp.mesh.entities_to_geometry(cpp_mesh, dim, entities, False)
+    return cpp_entities_to_geometry(cpp_mesh, dim, entities, False)
 
 
 def cell_vertex_count(msh) -> int:
@@ -147,6 +155,14 @@ def locate_component_dofs(V, component: int, facet_indices):
     """Dofs of one vector component on the given facets, as DOLFINx's dirichletbc wants them."""
     fdim = V.mesh.topology.dim - 1
     return dolfinx.fem.locate_dofs_topological(V.sub(component), fdim, facet_indices)
+
+
+def set_bc(b, bcs, scale: float = 1.0):
+    """b[dof] = scale · g[dof] at the Dirichlet DOFs (``scale`` is ``alpha`` from 0.8 on)."""
+    if NEW_API:
+        dolfinx.fem.petsc.set_bc(b, bcs, alpha=scale)
+    else:
+        dolfinx.fem.petsc.set_bc(b, bcs, scale=scale)
 
 
 def create_petsc_vector(V):

@@ -13,9 +13,8 @@ from typing import Optional, Sequence
 import numpy as np
 from petsc4py import PETSc
 
-import dolfinx.fem.petsc
 
-from . import _cpp
+from . import _cpp, compat
 from .pairing import NodePairs
 
 
@@ -73,7 +72,7 @@ class Condensation:
         """True for the contact DOFs that a Dirichlet condition fixes (rank 0)."""
         marker = K.createVecLeft()
         marker.set(1.0)
-        dolfinx.fem.petsc.set_bc(marker, list(bcs), scale=0.0)
+        compat.set_bc(marker, list(bcs), scale=0.0)
         vals = self.gather(marker)
         marker.destroy()
         return vals == 0.0 if vals is not None else None
