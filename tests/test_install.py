@@ -4,9 +4,9 @@ The install must work offline: pip may use only the system's setuptools and the 
 packages seen through --system-site-packages. The C++ build reuses build/temp.* of the
 checkout, so only the first run compiles everything.
 """
+import importlib.util
 import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -18,11 +18,8 @@ CHECK = ("import flexcontact, flexcontact.forms, flexcontact.meshes, flexcontact
 
 
 def _venv_available():
-    try:
-        import ensurepip  # noqa: F401  (Debian splits it into python3-venv)
-    except ImportError:
-        return False
-    return Path(PYTHON).exists()
+    # Debian puts ensurepip, which venv needs, in the separate package python3-venv.
+    return Path(PYTHON).exists() and importlib.util.find_spec("ensurepip") is not None
 
 
 @pytest.mark.slow
