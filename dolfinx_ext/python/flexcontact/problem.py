@@ -1,6 +1,6 @@
 """Static frictional contact between deformable bodies, loaded in increments.
 
-The flow is one-directional (DESIGN.md §3), one module per stage: ``assembly`` (K, p),
+The flow is one-directional (docs/architecture.md §2), one module per stage: ``assembly`` (K, p),
 ``pairing`` (node pairs of the contact interfaces), ``condensation`` (one MUMPS
 factorization gives F* = (K⁻¹)_cc on the contact DOFs; the kernel object holds B, x0,
 W = B F* Bᵀ and solves x = W λ + q per increment), ``postprocess`` (summaries and the
