@@ -1,6 +1,6 @@
 """What one load increment costs after set-up, against one back-substitution.
 
-The method's promise (DESIGN.md §1): all heavy sparse work happens once; an increment is
+The method's promise (docs/architecture.md §1): all heavy sparse work happens once; an increment is
 back-substitutions with the stored factor plus a small dense contact solve. On the Hertz
 geometry at growing sizes this measures, in one run: the factorization with F* (a), building
 W (b), one increment (c, without writing output) and one back-substitution (d), and writes

@@ -2,7 +2,7 @@
 # # Cattaneo–Mindlin partial slip: normal load P, then tangential load Q < μP
 #
 # A steel half-cylinder on a steel block — elastically similar bodies, so the normal and
-# tangential problems decouple (DESIGN.md §5). After the normal load P (Hertz: half-width
+# tangential problems decouple (docs/architecture.md §6). After the normal load P (Hertz: half-width
 # a) a tangential load Q < μP is applied. The centre of the contact sticks, the edges slip:
 #
 #     c = a sqrt(1 − Q/(μP)),

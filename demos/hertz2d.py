@@ -2,7 +2,7 @@
 # # Hertz contact of a cylinder on an elastic block (plane strain)
 #
 # A half-cylinder of radius R is pressed onto an elastic block by lowering its flat top.
-# Both bodies are steel. Near the contact the answer is Hertz's (DESIGN.md §5):
+# Both bodies are steel. Near the contact the answer is Hertz's (docs/architecture.md §6):
 #
 #     a = sqrt(4 P R / (π E*)),   p0 = 2 P / (π a),   p(x) = p0 sqrt(1 − x²/a²)
 #

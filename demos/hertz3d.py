@@ -2,7 +2,7 @@
 # # Hertz contact of a sphere on an elastic block (3D, quarter model)
 #
 # A column of steel whose lower end is a sphere of radius R is pressed onto a steel block by
-# lowering its flat top. Near the contact the answer is Hertz's (DESIGN.md §5):
+# lowering its flat top. Near the contact the answer is Hertz's (docs/architecture.md §6):
 #
 #     a = (3 P R / (4 E*))^(1/3),   p0 = 3 P / (2 π a²),   p(r) = p0 sqrt(1 − r²/a²)
 #

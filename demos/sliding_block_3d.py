@@ -5,7 +5,8 @@
 # load N) and then travels sideways by s(t)·(cos θ(t), sin θ(t), 0), pulling the block
 # through a compliant pad: the travel grows past the point of gross slip while its
 # direction turns by 90° in the x–y plane. In 3D the direction of slip is an unknown of
-# the problem (DESIGN.md §1): the friction force must follow the block around the bend.
+# the problem (docs/architecture.md §1): the friction force must follow the block around
+# the bend.
 #
 # What the demo measures:
 #
@@ -63,7 +64,7 @@ t_start = time.perf_counter()
 # interface meshes match node for node. The base's bottom is clamped. The platen holds the
 # height of the block's top; sideways the pad (springs per area k_pad [Pa/m]) joins the top
 # to the platen. The pad also keeps the block from moving freely in x, y and about z, so
-# K is invertible (DESIGN.md §4).
+# K is invertible (docs/architecture.md §1).
 
 # %%
 msh, cells, facets, geo = block_on_base.build_3d(comm, refine=args.refine)

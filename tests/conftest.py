@@ -33,5 +33,6 @@ def results_dir(tmp_path, monkeypatch):
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "mpi: runs a case with mpirun -n 2")
+    config.addinivalue_line("markers", "slow: takes minutes (builds or installs the package)")
     if shutil.which("mpirun") is None:
         raise RuntimeError("mpirun not found: install openmpi-bin (scripts/setup.sh does)")

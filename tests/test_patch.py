@@ -1,4 +1,4 @@
-"""The contact patch test (Taylor & Papadopoulos, DESIGN.md §5) on matching meshes, 2D plane
+"""The contact patch test (Taylor & Papadopoulos, docs/architecture.md §6) on matching meshes, 2D plane
 strain and 3D: uniform pressure through a flat interface must come out uniform.
 
 Two stacked bodies of one footprint (meshes/patch.py), unstructured meshes of different

@@ -1,9 +1,21 @@
 """flexcontact: frictional contact and impact for FEniCSx by the condensed flexibility
 (mixed) method of Feng & Touzot."""
 from . import _cpp  # noqa: F401  (the compiled kernel and PETSc/MUMPS bridge)
-from ._cpp import ConvergenceError, SolverOptions  # noqa: F401
-from .problem import ContactInterface, ContactProblem, IncrementSummary  # noqa: F401
-from .boundary import dirichlet  # noqa: F401
-from .output import ResultWriter, results_folder, write_summary  # noqa: F401
+# Errors users catch: a singular K (a body held by nothing), MUMPS or PETSc failing, no local
+# solver converging. All four are RuntimeErrors.
+from ._cpp import (ConvergenceError, MumpsError, PetscError, SingularStiffnessError,
+                   SolverOptions)
+from .boundary import dirichlet
+from .names import FLEXIBILITY_METHODS, SOLVER_NAMES, FlexibilityMethod, SolverName
+from .output import ResultWriter, results_folder, write_summary
+from .problem import ContactInterface, ContactProblem, IncrementSummary
 
 __version__ = "0.1.0"
+
+__all__ = [
+    "ContactInterface", "ContactProblem", "IncrementSummary", "SolverOptions",
+    "dirichlet", "ResultWriter", "results_folder", "write_summary",
+    "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES",
+    "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",
+    "__version__",
+]

@@ -1,4 +1,4 @@
-"""Closed-form answers of the verification catalogue (DESIGN.md §5), SI units.
+"""Closed-form answers of the verification catalogue (docs/architecture.md §6), SI units.
 
 Every function checks its input and raises ValueError naming the parameter and its value:
 a reference computed from a negative load or an impossible Poisson's ratio would otherwise

@@ -1,14 +1,24 @@
 """Dirichlet conditions on tagged facets, with values that load steps can change."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Optional, Sequence, Union
+
 import numpy as np
 import dolfinx.fem
 from petsc4py import PETSc
 
 from . import compat
 
+# DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never imported at run time.
+if TYPE_CHECKING:
+    from dolfinx.fem import Constant, DirichletBC, FunctionSpace
+    from dolfinx.mesh import MeshTags
 
-def dirichlet(V, facet_tags, value: int, components=None, displacement_m=0.0):
+
+def dirichlet(V: FunctionSpace, facet_tags: MeshTags, value: int,
+              components: Optional[Sequence[int]] = None,
+              displacement_m: Union[float, Sequence[float]] = 0.0,
+              ) -> tuple[list[DirichletBC], list[Constant]]:
     """Prescribe displacement components [m] on the facets tagged ``value``.
 
     Returns ``(bcs, constants)``: a list of DirichletBC (one per component) and the

@@ -1,5 +1,5 @@
 """Condensation on the contact DOFs: F* = (K⁻¹)_cc, the scatter of contact values between
-the distributed vectors and rank 0, and the kernel's condensed problem (DESIGN.md §1).
+the distributed vectors and rank 0, and the kernel's condensed problem (docs/architecture.md §1).
 
 The method's algebra (B, x0, W = B F* Bᵀ, q = B u_p + x0, the contact solve, r_c = Bᵀ λ and
 the totals) lives in the kernel object ``_cpp.CondensedContact`` on rank 0, so that an

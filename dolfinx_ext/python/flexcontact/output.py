@@ -5,6 +5,7 @@ import json
 import os
 from dataclasses import asdict
 from pathlib import Path
+from typing import TYPE_CHECKING, Sequence, Union
 
 import numpy as np
 from mpi4py import MPI
@@ -12,6 +13,12 @@ from mpi4py import MPI
 import dolfinx.io
 
 from . import compat
+
+# DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never imported at run time.
+if TYPE_CHECKING:
+    from dolfinx.mesh import Mesh, MeshTags
+
+    from .problem import ContactProblem
 
 
 class ResultWriter:
@@ -21,7 +28,8 @@ class ResultWriter:
     increments done before it.
     """
 
-    def __init__(self, folder, name: str, msh, tags=()):
+    def __init__(self, folder: Union[str, os.PathLike], name: str, msh: Mesh,
+                 tags: Sequence[MeshTags] = ()):
         self.folder = Path(folder)
         if msh.comm.rank == 0:
             self.folder.mkdir(parents=True, exist_ok=True)
@@ -30,19 +38,19 @@ class ResultWriter:
         self._xdmf = dolfinx.io.XDMFFile(msh.comm, str(self.path), "w")
         compat.write_mesh_and_tags(self._xdmf, msh, tags)
 
-    def write(self, problem, t: float):
+    def write(self, problem: ContactProblem, t: float) -> None:
         for f in problem.fields():
             self._xdmf.write_function(f, t)
 
-    def close(self):
+    def close(self) -> None:
         if self._xdmf is not None:
             self._xdmf.close()
             self._xdmf = None
 
-    def __enter__(self):
+    def __enter__(self) -> ResultWriter:
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc) -> bool:
         self.close()
         return False
 
@@ -53,7 +61,8 @@ def results_folder(name: str) -> Path:
     return base / name
 
 
-def write_summary(folder, data: dict, comm=MPI.COMM_WORLD):
+def write_summary(folder: Union[str, os.PathLike], data: dict,
+                  comm: MPI.Comm = MPI.COMM_WORLD) -> None:
     """Write ``summary.json`` on rank 0 (NumPy values become plain numbers)."""
     if comm.rank != 0:
         return

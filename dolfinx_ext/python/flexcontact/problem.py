@@ -1,6 +1,6 @@
 """Static frictional contact between deformable bodies, loaded in increments.
 
-The flow is one-directional (DESIGN.md §3), one module per stage: ``assembly`` (K, p),
+The flow is one-directional (docs/architecture.md §2), one module per stage: ``assembly`` (K, p),
 ``pairing`` (node pairs of the contact interfaces), ``condensation`` (one MUMPS
 factorization gives F* = (K⁻¹)_cc on the contact DOFs; the kernel object holds B, x0,
 W = B F* Bᵀ and solves x = W λ + q per increment), ``postprocess`` (summaries and the
@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -21,10 +21,17 @@ from . import compat
 from ._cpp import ConvergenceError, SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
+from .names import FlexibilityMethod, check_chain, check_flexibility_method
 from .pairing import pair_interfaces
 from .postprocess import (STATE_NAMES, ContactFields, IncrementResult,  # noqa: F401
                           IncrementSummary, record_increment)
 from .rigid_modes import check_bodies
+
+# Annotations use DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never at run time.
+if TYPE_CHECKING:
+    import ufl
+    from dolfinx.fem import DirichletBC
+    from dolfinx.mesh import MeshTags
 
 
 @dataclass
@@ -36,7 +43,7 @@ class ContactInterface:
     largest tangential offset between paired nodes (default: 1e-6 of the surfaces' extent).
     """
 
-    facet_tags: object
+    facet_tags: MeshTags
     slave: int
     master: int
     mu: float
@@ -80,8 +87,14 @@ class ContactProblem:
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
     """
 
-    def __init__(self, a, L, bcs: Sequence, contact, *, bodies=None,
-                 stress: Optional[Callable] = None, solver=None, flexibility: str = "schur"):
+    def __init__(self, a: ufl.Form, L: Optional[ufl.Form], bcs: Sequence[DirichletBC],
+                 contact: Union[ContactInterface, Sequence[ContactInterface]], *,
+                 bodies: Optional[tuple[MeshTags, dict[str, int]]] = None,
+                 stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
+                 flexibility: FlexibilityMethod = "schur"):
+        check_flexibility_method(flexibility)
+        if solver is not None:
+            check_chain(solver.chain)
         self.interfaces = list(contact) if isinstance(contact, (list, tuple)) else [contact]
         if not self.interfaces:
             raise ValueError("no contact interface given")
@@ -188,6 +201,6 @@ class ContactProblem:
                 print(inc.summary.line(), flush=True)
         return out
 
-    def fields(self):
+    def fields(self) -> list[dolfinx.fem.Function]:
         """The output Functions (displacement, pressure, traction, status[, von Mises])."""
         return self.outputs.all()

@@ -2,7 +2,7 @@
 #pragma once
 
 /// @file condensed.hpp
-/// @brief The condensed contact problem x = W λ + q as one object (DESIGN.md §1, §3).
+/// @brief The condensed contact problem x = W λ + q as one object (docs/architecture.md §1, §2).
 ///
 /// It owns the gap operator B, the initial gap x0, W = B F* Bᵀ and the incremental driver, so
 /// that one increment is one call: the contact-DOF values of u_p = K⁻¹ p go in; λ, the gap,

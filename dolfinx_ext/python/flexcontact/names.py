@@ -1,0 +1,37 @@
+"""The names users pass as strings: flexibility methods and local contact solvers.
+
+They are checked in Python, before any assembly or factorization, so that a typo fails at
+once with the list of accepted names instead of minutes later inside the C++ layer.
+"""
+from __future__ import annotations
+
+from typing import Iterable, Literal, get_args
+
+FlexibilityMethod = Literal["schur", "inverse_entries", "matmatsolve"]
+"""How F* = (K⁻¹)_cc is computed: MUMPS Schur complement (on several ranks it runs as
+"inverse_entries"), MUMPS selected inverse entries, or a multi-right-hand-side solve."""
+
+SolverName = Literal["newton_ac", "active_set", "projection"]
+"""Local contact solvers of ``SolverOptions.chain``: semi-smooth Newton on Alart–Curnier,
+the Feng–Touzot active set, the De Saxcé–Feng projection."""
+
+FLEXIBILITY_METHODS: tuple[str, ...] = get_args(FlexibilityMethod)
+SOLVER_NAMES: tuple[str, ...] = get_args(SolverName)
+
+
+def check_flexibility_method(method: str) -> FlexibilityMethod:
+    """``method`` itself if it is a flexibility method; ValueError naming it otherwise."""
+    if method not in FLEXIBILITY_METHODS:
+        raise ValueError(f"unknown flexibility method {method!r}; "
+                         f"allowed: {', '.join(FLEXIBILITY_METHODS)}")
+    return method
+
+
+def check_chain(chain: Iterable[str]) -> list[SolverName]:
+    """The chain as a list if every name is a local solver; ValueError naming the bad one."""
+    names = list(chain)
+    for name in names:
+        if name not in SOLVER_NAMES:
+            raise ValueError(f"unknown contact solver {name!r} in the chain; "
+                             f"allowed: {', '.join(SOLVER_NAMES)}")
+    return names
