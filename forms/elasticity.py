@@ -7,6 +7,7 @@ Lamé constant λ in Pa. For ``kind="plane_stress"`` the pair is converted to th
 """
 
 import ufl
+from ufl.domain import extract_unique_domain
 
 from .material import Material, check_kind
 
@@ -109,7 +110,7 @@ def elasticity_form(u, v, materials, dx=None, kind="plane_strain", cell_tags=Non
     """
     _check_dim(u, kind)
     if dx is None:
-        dx = ufl.Measure("dx", domain=u.ufl_domain(), subdomain_data=cell_tags)
+        dx = ufl.Measure("dx", domain=extract_unique_domain(u), subdomain_data=cell_tags)
     if not isinstance(materials, dict):
         return ufl.inner(sigma(u, materials, kind), epsilon(v)) * dx
     if not materials:

@@ -5,6 +5,7 @@ otherwise; gravity points towards negative values of it.
 """
 
 import ufl
+from ufl.domain import extract_unique_domain
 
 from .material import Material
 
@@ -63,8 +64,8 @@ def hydrostatic_pressure(v, ds, level, rho_w=WATER_DENSITY_KG_M3, g=STANDARD_GRA
     pressure pushes into the body. Points above the water level carry no load.
     """
     d, axis = _axis(v, vertical_axis)
-    x = ufl.SpatialCoordinate(v.ufl_domain())
-    n = ufl.FacetNormal(v.ufl_domain())
+    x = ufl.SpatialCoordinate(extract_unique_domain(v))
+    n = ufl.FacetNormal(extract_unique_domain(v))
     p = rho_w * g * ufl.max_value(level - x[axis], 0.0)
     return -p * ufl.dot(n, v) * ds
 

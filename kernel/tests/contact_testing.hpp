@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <functional>
 #include <initializer_list>
 #include <random>
 #include <sstream>
@@ -21,6 +23,20 @@
 
 namespace flexcontact::testing
 {
+/// @brief What f throws, as text ("" if it does not throw): tests assert on the words.
+inline std::string message_of(const std::function<void()>& f)
+{
+  try
+  {
+    f();
+  }
+  catch (const std::exception& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+
 /// @brief A vector written out in place, so that hand-derived values read as in the
 /// derivation next to them.
 inline Vector vec(std::initializer_list<double> v)

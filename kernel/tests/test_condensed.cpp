@@ -18,19 +18,6 @@ using namespace flexcontact::testing;
 
 namespace
 {
-std::string message_of(const std::function<void()>& f)
-{
-  try
-  {
-    f();
-  }
-  catch (const std::exception& e)
-  {
-    return e.what();
-  }
-  return "";
-}
-
 // The message text, shown when the expected part is missing.
 #define EXPECT_CONTAINS(text, part)                                                          \
   do                                                                                         \

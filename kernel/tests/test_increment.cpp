@@ -18,19 +18,6 @@ using namespace flexcontact::testing;
 
 namespace
 {
-std::string message_of(const std::function<void()>& f)
-{
-  try
-  {
-    f();
-  }
-  catch (const std::exception& e)
-  {
-    return e.what();
-  }
-  return "";
-}
-
 // A block on springs: normal compliance 1/k, tangential 1/k_t. Pressed down by N = k δ,
 // pushed sideways by T: without contact the tangential gap would be T/k_t.
 constexpr double k = 1e3, kt = 1e2, N = 10.0, mu0 = 0.5;
