@@ -8,6 +8,7 @@ parameter cannot leave the other ranks waiting in a broadcast.
 
 import gmsh
 import dolfinx.io.gmshio as gmshio  # the submodule must be imported explicitly in 0.5
+from flexcontact.mpi import raise_on_every_rank
 
 _owned = False  # True while gmsh was initialised by this module (so we finalise it)
 
@@ -74,9 +75,7 @@ def generate(comm, name: str, build_model, gdim: int):
         except Exception as exc:  # re-raised on every rank below
             error = exc
             stop()
-    error = comm.bcast(error, root=0)
-    if error is not None:
-        raise error
+    raise_on_every_rank(comm, error)
     info = comm.bcast(info, root=0)
     msh, cell_tags, facet_tags = to_dolfinx(comm, gdim)
     return msh, cell_tags, facet_tags, info

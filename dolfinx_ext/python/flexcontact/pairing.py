@@ -15,6 +15,7 @@ import numpy as np
 
 from . import compat
 from .surface import surface_nodes
+from .mpi import raise_on_every_rank
 
 
 @dataclass
@@ -114,9 +115,7 @@ def pair_interfaces(V, interfaces: Sequence, comm) -> tuple[Optional[NodePairs],
                 mus.append(np.full(parts[-1].m, float(itf.mu)))
             except ValueError as e:
                 error = str(e)
-    error = comm.bcast(error, root=0)
-    if error:
-        raise ValueError(error)
+    raise_on_every_rank(comm, error)
     pairs = concat(parts) if root else None
     mu = np.concatenate(mus) if root else np.zeros(0)
     return pairs, mu, comm.bcast(pairs.m if root else None, root=0)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .mpi import raise_on_every_rank
+
 
 def set_nodal_values(u, dofs, values) -> None:
     """Set the listed DOFs of ``u`` to ``values``; every other DOF keeps its value.
@@ -34,9 +36,7 @@ def set_nodal_values(u, dofs, values) -> None:
             bad = int(g.min() if g.min() < 0 else g.max())
             error = f"set_nodal_values: DOF index {bad} out of range [0, {n_global})"
         payload = (g, v)
-    error = comm.bcast(error, root=0)
-    if error:
-        raise ValueError(error)
+    raise_on_every_rank(comm, error)
     g, v = comm.bcast(payload, root=0)   # surface-sized: every rank keeps what it owns
     start, end = imap.local_range
     block = g // bs
