@@ -1,6 +1,7 @@
 """Test set-up: import this checkout's package (not another clone's) and share helpers."""
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -20,8 +21,19 @@ def mpirun(n, script, *args, timeout=600, cwd=None, env=None):
     e = dict(os.environ)
     e["PYTHONPATH"] = str(ROOT / "dolfinx_ext" / "python") + os.pathsep + e.get("PYTHONPATH", "")
     e.update(env or {})
-    return subprocess.run(cmd, cwd=cwd or ROOT, env=e, capture_output=True, text=True,
-                          timeout=timeout, check=True)
+    # Its own process group, so that a timeout ends the ranks too: a rank left waiting in
+    # a collective call would otherwise spin on after the test has failed.
+    with subprocess.Popen(cmd, cwd=cwd or ROOT, env=e, stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, start_new_session=True) as proc:
+        try:
+            out, err = proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            out, err = proc.communicate()
+            raise subprocess.TimeoutExpired(cmd, timeout, out, err)
+    if proc.returncode != 0:
+        raise subprocess.CalledProcessError(proc.returncode, cmd, out, err)
+    return subprocess.CompletedProcess(cmd, 0, out, err)
 
 
 @pytest.fixture
