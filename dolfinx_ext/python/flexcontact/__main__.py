@@ -16,6 +16,11 @@ def main(argv=None):
         print(json.dumps(describe(), indent=2))
     elif args.cmd == "demos":
         root = Path(__file__).resolve().parents[3] / "demos"
+        if not root.is_dir():
+            # A pip-installed package carries the library only; demos are scripts of the
+            # source repository.
+            raise SystemExit("the demos are scripts of the flexcontact source repository "
+                             "(its demos/ folder); this installed package has none")
         for d in sorted(root.glob("*.py")):
             doc = next((l[4:].strip() for l in d.read_text().splitlines()
                         if l.startswith("# # ")), "")
