@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -143,6 +144,206 @@ const char* state_name(PairState s)
 {
   return s == PairState::open ? "open" : s == PairState::stick ? "stick" : "slip";
 }
+
+/// @brief Fills A and b with the modified system: each pair's state replaces its rows of
+/// u = W λ + q. The rows that state a force are scaled by c_k (see row_scales).
+void build_modified_system(const ProblemView& p, const std::vector<PairState>& states,
+                           const Matrix& dir, const Vector& c, Matrix& A, Vector& b)
+{
+  const int d = p.dim;
+  for (int k = 0; k < p.pairs(); ++k)
+  {
+    const int i = k * d;
+    switch (states[k])
+    {
+    case PairState::stick: // u_k = 0: the pair's rows of W λ + q
+      A.middleRows(i, d) = p.W.middleRows(i, d);
+      b.segment(i, d) = -p.q.segment(i, d);
+      break;
+    case PairState::slip: // u_n = 0 and λ_t + μ λ_n s = 0 (friction opposes slip s)
+      A.row(i) = p.W.row(i);
+      b[i] = -p.q[i];
+      A.middleRows(i + 1, d - 1).setZero();
+      for (int j = 1; j < d; ++j)
+      {
+        A(i + j, i + j) = c[k];
+        A(i + j, i) = c[k] * p.mu[k] * dir(j - 1, k);
+        b[i + j] = 0.0;
+      }
+      break;
+    case PairState::open: // λ_k = 0
+      A.middleRows(i, d).setZero();
+      for (int j = 0; j < d; ++j)
+      {
+        A(i + j, i + j) = c[k];
+        b[i + j] = 0.0;
+      }
+      break;
+    }
+  }
+}
+
+/// @brief What the switching rules compare against: force and displacement thresholds,
+/// below which a value counts as zero, and the relaxation of the 3D direction update.
+struct SwitchParams
+{
+  double ftol;
+  double gtol;
+  double omega;
+};
+
+/// @brief Next slip direction of a frictional 3D pair k that keeps slipping; raises turn
+/// to the change of the direction.
+void update_slip_direction(const ProblemView& p, int k, double ln, const Eigen::VectorXd& ut,
+                           const Vector& c, double omega, Matrix& dir, double& turn)
+{
+  // The seed's projection form of the explicit method: the next direction is
+  // that of λ_t − ρ u_t projected on the disc of radius μλ_n, i.e. the assumed
+  // direction weighted by the friction force μλ_n and this iterate's slip by
+  // ρ|u_t| = |u_t|/c_k. The weights are in force units, so a pair that barely
+  // slips keeps its direction and one that slides far takes its slip's; relaxed
+  // further (omega < 1) once the update has been seen to oscillate.
+  const double wf = p.mu[k] * std::max(ln, 0.0);
+  Eigen::VectorXd s = wf * dir.col(k) + ut / c[k];
+  s = omega * s / s.norm() + (1.0 - omega) * dir.col(k);
+  if (!(s.norm() > 0.5 * omega))
+    s = ut; // the slip turned round: relaxation would cancel, take it as is
+  s.normalize();
+  turn = std::max(turn, (s - dir.col(k)).norm());
+  dir.col(k) = s;
+}
+
+/// @brief The switching rules: the state pair k takes from this iterate's λ and u, given
+/// its state in the system just solved. May update the pair's slip direction.
+PairState switch_pair(const ProblemView& p, int k, PairState state, const Vector& lambda,
+                      const Vector& u, const Vector& c, const SwitchParams& sw, Matrix& dir,
+                      double& turn)
+{
+  const int d = p.dim;
+  const int i = k * d;
+  const double ln = lambda[i];
+  const Eigen::VectorXd lt = tangent(lambda, k, d), ut = tangent(u, k, d);
+  switch (state)
+  {
+  case PairState::stick:
+    // Slip is tried before open: a stuck pair pulled apart (λ_n < 0) while sheared
+    // may well be sliding, and going straight to open is what makes the plain
+    // iteration cycle (stick → open → stick). A slip pair still in tension opens next.
+    if (lt.norm() > p.mu[k] * ln + sw.ftol && lt.norm() > sw.ftol)
+    {
+      dir.col(k) = -lt / lt.norm(); // the slip opposes the force that broke adhesion
+      return PairState::slip;
+    }
+    if (ln < -sw.ftol)
+      return PairState::open;
+    break;
+  case PairState::slip:
+    if (ln < -sw.ftol)
+      return PairState::open;
+    if (p.mu[k] == 0.0)
+    {
+      // No friction: the direction does not enter the system; keep it for reporting.
+      if (ut.norm() > sw.gtol)
+        dir.col(k) = ut / ut.norm();
+    }
+    else if (ut.dot(dir.col(k)) < -sw.gtol)
+      return PairState::stick; // the assumed slip reversed
+    else if (d == 3 && ut.norm() > sw.gtol)
+      update_slip_direction(p, k, ln, ut, c, sw.omega, dir, turn);
+    break;
+  case PairState::open:
+    if (u[i] < -sw.gtol)
+      return PairState::stick;
+    break;
+  }
+  return state;
+}
+
+/// @brief Applies the switching rules to every pair; returns the number of state changes
+/// and raises turn to the largest change of a 3D slip direction.
+int switch_states(const ProblemView& p, const Vector& lambda, const Vector& u, const Vector& c,
+                  const SwitchParams& sw, int iteration, bool verbose,
+                  std::vector<PairState>& states, Matrix& dir, double& turn)
+{
+  int changes = 0;
+  for (int k = 0; k < p.pairs(); ++k)
+  {
+    const PairState old = states[k];
+    states[k] = switch_pair(p, k, old, lambda, u, c, sw, dir, turn);
+    if (states[k] != old)
+    {
+      ++changes;
+      if (verbose)
+        std::cerr << "active_set: iteration " << iteration << ": pair " << k << " "
+                  << state_name(old) << " -> " << state_name(states[k]) << "\n";
+    }
+  }
+  return changes;
+}
+
+/// @brief Revisit detection on the discrete part of the iteration (state_key). Changed
+/// states that come back are a cycle; 3D directions alone that come back mean the explicit
+/// direction update oscillates, which halves its relaxation omega instead.
+class CycleDetector
+{
+public:
+  CycleDetector(const std::vector<PairState>& states, const Matrix& dir,
+                const Eigen::Ref<const Vector>& mu)
+      : last_key_(state_key(states, dir, mu))
+  {
+    seen_.insert(last_key_);
+  }
+
+  /// @brief Relaxation of the 3D slip-direction update.
+  double omega() const { return omega_; }
+
+  /// @brief Records the states and directions after a switching pass that made `changes`
+  /// changes; true if the iteration cycles.
+  bool cycles(const std::vector<PairState>& states, const Matrix& dir,
+              const Eigen::Ref<const Vector>& mu, int changes, int iteration, bool verbose)
+  {
+    auto key = state_key(states, dir, mu);
+    const bool same_as_last = (key == last_key_);
+    last_key_ = key;
+    if (changes == 0 && same_as_last)
+      return false; // directions still settling below the key's resolution: not a revisit
+    if (seen_.insert(std::move(key)).second)
+      return false;
+    if (changes == 0 && omega_ > 1.0 / 64.0)
+    {
+      // Only 3D directions moved and they came back: the explicit update oscillates
+      // about the answer. Relax it and forget the directions seen so far.
+      omega_ *= 0.5;
+      seen_.clear();
+      seen_.insert(state_key(states, dir, mu));
+      if (verbose)
+        std::cerr << "active_set: iteration " << iteration
+                  << ": slip directions oscillate; relaxation " << omega_ << "\n";
+      return false;
+    }
+    if (verbose)
+      std::cerr << "active_set: iteration " << iteration
+                << ": state vector seen before; the iteration cycles\n";
+    return true;
+  }
+
+private:
+  std::set<std::vector<std::int64_t>> seen_;
+  std::vector<std::int64_t> last_key_;
+  double omega_ = 1.0;
+};
+
+/// @brief Fills the report's answer from the best iterate, which need not be the last when
+/// the iteration cycled or ran out of iterations.
+void finish_report(const ProblemView& p, const Vector& best_lambda, double tolerance,
+                   SolveReport& rep)
+{
+  rep.lambda = best_lambda;
+  rep.u = p.W * rep.lambda + p.q;
+  rep.residual = natural_map_residual(p, rep.lambda);
+  rep.states = classify_states(p, rep.lambda, rep.u);
+  rep.converged = rep.residual <= tolerance;
+}
 } // namespace
 
 SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
@@ -174,47 +375,13 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
 
   Vector best_lambda = lambda;
   double best_residual = natural_map_residual(p, lambda);
-
-  std::set<std::vector<std::int64_t>> seen;
-  std::vector<std::int64_t> last_key = state_key(states, dir, p.mu);
-  seen.insert(last_key);
-  double omega = 1.0; // relaxation of the 3D slip-direction update
+  CycleDetector detector(states, dir, p.mu);
 
   Matrix A(n, n);
   Vector b(n), x(n);
   while (rep.iterations < opt.max_iterations)
   {
-    // --- the modified system: each pair's state replaces its rows -------------------
-    for (int k = 0; k < m; ++k)
-    {
-      const int i = k * d;
-      switch (states[k])
-      {
-      case PairState::stick: // u_k = 0: the pair's rows of W λ + q
-        A.middleRows(i, d) = p.W.middleRows(i, d);
-        b.segment(i, d) = -p.q.segment(i, d);
-        break;
-      case PairState::slip: // u_n = 0 and λ_t + μ λ_n s = 0 (friction opposes slip s)
-        A.row(i) = p.W.row(i);
-        b[i] = -p.q[i];
-        A.middleRows(i + 1, d - 1).setZero();
-        for (int j = 1; j < d; ++j)
-        {
-          A(i + j, i + j) = c[k];
-          A(i + j, i) = c[k] * p.mu[k] * dir(j - 1, k);
-          b[i + j] = 0.0;
-        }
-        break;
-      case PairState::open: // λ_k = 0
-        A.middleRows(i, d).setZero();
-        for (int j = 0; j < d; ++j)
-        {
-          A(i + j, i + j) = c[k];
-          b[i + j] = 0.0;
-        }
-        break;
-      }
-    }
+    build_modified_system(p, states, dir, c, A, b);
     ++rep.iterations;
     if (!solve_dense(A, b, x))
     {
@@ -233,74 +400,12 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
       best_lambda = lambda;
     }
 
-    // --- switching -------------------------------------------------------------------
     const double fscale = std::max({lambda.cwiseAbs().maxCoeff(), rho_q.cwiseAbs().maxCoeff(), tiny});
     const double gscale = std::max({u.cwiseAbs().maxCoeff(), p.q.cwiseAbs().maxCoeff(), tiny});
-    const double ftol = tau * fscale, gtol = tau * gscale;
-    int changes = 0;
-    double turn = 0.0; // largest change of a 3D slip direction
-    for (int k = 0; k < m; ++k)
-    {
-      const int i = k * d;
-      const double ln = lambda[i];
-      const Eigen::VectorXd lt = tangent(lambda, k, d), ut = tangent(u, k, d);
-      const PairState old = states[k];
-      switch (old)
-      {
-      case PairState::stick:
-        // Slip is tried before open: a stuck pair pulled apart (λ_n < 0) while sheared
-        // may well be sliding, and going straight to open is what makes the plain
-        // iteration cycle (stick → open → stick). A slip pair still in tension opens next.
-        if (lt.norm() > p.mu[k] * ln + ftol && lt.norm() > ftol)
-        {
-          states[k] = PairState::slip;
-          dir.col(k) = -lt / lt.norm(); // the slip opposes the force that broke adhesion
-        }
-        else if (ln < -ftol)
-          states[k] = PairState::open;
-        break;
-      case PairState::slip:
-        if (ln < -ftol)
-          states[k] = PairState::open;
-        else if (p.mu[k] == 0.0)
-        {
-          // No friction: the direction does not enter the system; keep it for reporting.
-          if (ut.norm() > gtol)
-            dir.col(k) = ut / ut.norm();
-        }
-        else if (ut.dot(dir.col(k)) < -gtol)
-          states[k] = PairState::stick; // the assumed slip reversed
-        else if (d == 3 && ut.norm() > gtol)
-        {
-          // The seed's projection form of the explicit method: the next direction is
-          // that of λ_t − ρ u_t projected on the disc of radius μλ_n, i.e. the assumed
-          // direction weighted by the friction force μλ_n and this iterate's slip by
-          // ρ|u_t| = |u_t|/c_k. The weights are in force units, so a pair that barely
-          // slips keeps its direction and one that slides far takes its slip's; relaxed
-          // further (omega < 1) once the update has been seen to oscillate.
-          const double wf = p.mu[k] * std::max(ln, 0.0);
-          Eigen::VectorXd s = wf * dir.col(k) + ut / c[k];
-          s = omega * s / s.norm() + (1.0 - omega) * dir.col(k);
-          if (!(s.norm() > 0.5 * omega))
-            s = ut; // the slip turned round: relaxation would cancel, take it as is
-          s.normalize();
-          turn = std::max(turn, (s - dir.col(k)).norm());
-          dir.col(k) = s;
-        }
-        break;
-      case PairState::open:
-        if (u[i] < -gtol)
-          states[k] = PairState::stick;
-        break;
-      }
-      if (states[k] != old)
-      {
-        ++changes;
-        if (opt.verbose)
-          std::cerr << "active_set: iteration " << rep.iterations << ": pair " << k << " "
-                    << state_name(old) << " -> " << state_name(states[k]) << "\n";
-      }
-    }
+    const SwitchParams sw{tau * fscale, tau * gscale, detector.omega()};
+    double turn = 0.0;
+    const int changes
+        = switch_states(p, lambda, u, c, sw, rep.iterations, opt.verbose, states, dir, turn);
     rep.state_changes += changes;
     if (opt.verbose)
       std::cerr << "active_set: iteration " << rep.iterations << ": " << changes
@@ -310,38 +415,14 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
       break; // certified: nothing left to switch that matters
     if (changes == 0 && turn <= 1e-14)
       break; // fixed point of states and directions (uncertified if res > tolerance)
-    auto key = state_key(states, dir, p.mu);
-    const bool same_as_last = (key == last_key);
-    last_key = key;
-    if (changes == 0 && same_as_last)
-      continue; // directions still settling below the key's resolution: not a revisit
-    if (!seen.insert(std::move(key)).second)
+    if (detector.cycles(states, dir, p.mu, changes, rep.iterations, opt.verbose))
     {
-      if (changes == 0 && omega > 1.0 / 64.0)
-      {
-        // Only 3D directions moved and they came back: the explicit update oscillates
-        // about the answer. Relax it and forget the directions seen so far.
-        omega *= 0.5;
-        seen.clear();
-        seen.insert(state_key(states, dir, p.mu));
-        if (opt.verbose)
-          std::cerr << "active_set: iteration " << rep.iterations
-                    << ": slip directions oscillate; relaxation " << omega << "\n";
-        continue;
-      }
       rep.cycled = true;
-      if (opt.verbose)
-        std::cerr << "active_set: iteration " << rep.iterations
-                  << ": state vector seen before; the iteration cycles\n";
       break;
     }
   }
 
-  rep.lambda = best_lambda;
-  rep.u = p.W * rep.lambda + p.q;
-  rep.residual = natural_map_residual(p, rep.lambda);
-  rep.states = classify_states(p, rep.lambda, rep.u);
-  rep.converged = rep.residual <= opt.tolerance;
+  finish_report(p, best_lambda, opt.tolerance, rep);
   return rep;
 }
 } // namespace flexcontact

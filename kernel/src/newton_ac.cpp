@@ -10,8 +10,10 @@
 
 #include <Eigen/LU>
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 namespace flexcontact
@@ -56,6 +58,163 @@ bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
   x = Eigen::PartialPivLU<Matrix>(R).solve(b);
   return x.allFinite();
 }
+
+/// @brief Φ and the blocks ∂P/∂z at (λ, u); returns the merit ½‖Φ‖².
+double merit(const ProblemView& p, const Vector& rho, const Vector& rho_t, const Vector& lam,
+             const Vector& u, Vector& phi, std::vector<double>& dP)
+{
+  ac_all(p, rho, rho_t, lam, u, phi, &dP);
+  return 0.5 * phi.squaredNorm();
+}
+
+/// @brief The pairs whose block ∂P/∂z is not zero; the others (open) decouple from the
+/// Newton system.
+void closed_pairs(const std::vector<double>& dP, int m, int d, std::vector<int>& closed)
+{
+  closed.clear();
+  for (int k = 0; k < m; ++k)
+  {
+    const double* D = dP.data() + k * d * d;
+    bool nz = false;
+    for (int i = 0; i < d * d; ++i)
+      nz = nz || D[i] != 0.0;
+    if (nz)
+      closed.push_back(k);
+  }
+}
+
+/// @brief Newton direction dl from the generalised Jacobian, J Δ = −Φ with
+/// J = I − D (I − ρW) = (I − D) + D ρ W, D = blockdiag(∂P/∂z). Pairs with D_k = 0 (open)
+/// have identity rows: Δ_k = −Φ_k; only the closed block is factorised, which keeps the
+/// dense LU to the size of the contact zone. Returns false if that block has no solution.
+bool newton_direction(const ProblemView& p, const Vector& rho, const Vector& rho_t,
+                      const Vector& phi, const std::vector<double>& dP,
+                      const std::vector<int>& closed, Vector& dl)
+{
+  const int d = p.dim;
+  dl = -phi;
+  const int nc = static_cast<int>(closed.size());
+  if (nc == 0)
+    return true;
+  // Rows of the closed pairs: (I−D)_kk Δ_k + D_k ρ_k Σ_j W_kj Δ_j = −Φ_k, with Δ_open known.
+  // Since Δ = −Φ on open pairs, W_kj Δ_j for open j moves to the right-hand side; the
+  // full product WΔ₀ (Δ₀ zero on closed pairs) gives it at once.
+  Vector d0 = dl;
+  for (int k : closed)
+    d0.segment(k * d, d).setZero();
+  const Vector Wd0 = p.W * d0;
+  Matrix A(nc * d, nc * d);
+  Vector b(nc * d);
+  for (int a = 0; a < nc; ++a)
+  {
+    const int k = closed[a];
+    Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+        D(dP.data() + k * d * d, d, d);
+    Matrix Dr = D;
+    Dr.col(0) *= rho[k];
+    Dr.rightCols(d - 1) *= rho_t[k];
+    for (int c = 0; c < nc; ++c)
+      A.block(a * d, c * d, d, d).noalias() = Dr * p.W.block(k * d, closed[c] * d, d, d);
+    A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - D;
+    b.segment(a * d, d) = -phi.segment(k * d, d) - Dr * Wd0.segment(k * d, d);
+  }
+  Vector x;
+  if (!linear_solve(A, b, x))
+    return false;
+  for (int a = 0; a < nc; ++a)
+    dl.segment(closed[a] * d, d) = x.segment(a * d, d);
+  return true;
+}
+
+/// @brief Non-monotone reference of the line search: the largest merit of the last few
+/// accepted iterates lets the iteration pass the shallow ridges the kinks of Φ create
+/// (Grippo–Lampariello–Lucidi).
+class MeritHistory
+{
+public:
+  explicit MeritHistory(double f) : f_{f} {}
+
+  /// @brief Forgets the earlier iterates (after a restart).
+  void reset(double f) { f_.assign(1, f); }
+
+  void push(double f)
+  {
+    f_.push_back(f);
+    if (static_cast<int>(f_.size()) > memory)
+      f_.erase(f_.begin());
+  }
+
+  double reference() const { return *std::max_element(f_.begin(), f_.end()); }
+
+private:
+  static constexpr int memory = 5;
+  std::vector<double> f_;
+};
+
+/// @brief The line search's trial iterate: λ + α Δ, u + α WΔ, its Φ, and WΔ.
+struct Trial
+{
+  Vector lam, u, phi, Wdl;
+};
+
+/// @brief Line search on ½‖Φ‖², Armijo with the non-monotone reference of history. If the
+/// Newton direction dl gives no decrease, the fixed-point direction −Φ (a projected step)
+/// replaces it. Returns true with the accepted iterate in t.
+bool line_search(const ProblemView& p, const Vector& rho, const Vector& rho_t,
+                 const Vector& lam, const Vector& u, const Vector& phi, double f,
+                 const MeritHistory& history, Vector& dl, Trial& t)
+{
+  constexpr double sigma = 1e-4;
+  const double fref = history.reference();
+  for (int attempt = 0; attempt < 2; ++attempt)
+  {
+    if (attempt == 1)
+      dl = -phi;
+    t.Wdl.noalias() = p.W * dl;
+    double alpha = 1.0;
+    for (int ls = 0; ls < 40; ++ls, alpha *= 0.5)
+    {
+      t.lam = lam + alpha * dl;
+      t.u = u + alpha * t.Wdl;
+      ac_all(p, rho, rho_t, t.lam, t.u, t.phi, nullptr);
+      const double ft = 0.5 * t.phi.squaredNorm();
+      if (std::isfinite(ft) && ft <= fref - 2.0 * sigma * alpha * f)
+        return true;
+    }
+  }
+  return false;
+}
+
+/// @brief A few Gauss–Seidel sweeps with exact pair solves, stopping early once the
+/// residual res meets the tolerance. They move λ to where Newton regains its fast local
+/// convergence (they succeed where the kinks of Φ trap Newton).
+void gauss_seidel_sweeps(const ProblemView& p, const Vector& rho, double tolerance,
+                         Vector& lam, Vector& u, double& res)
+{
+  for (int s = 0; s < 5 && res > tolerance; ++s)
+  {
+    detail::nsgs_sweep(p, rho, lam, u);
+    u.noalias() = p.W * lam + p.q;
+    res = natural_map_residual(p, lam, u, rho);
+  }
+}
+
+/// @brief Fills the report from the last iterate; why ends the attempt's line.
+void finish_report(const ProblemView& p, const Vector& lam, int it, int sweeps_used,
+                   std::string why, double tolerance, SolveReport& rep)
+{
+  rep.iterations = it;
+  rep.lambda = lam;
+  rep.u = p.W * lam + p.q;
+  rep.residual = natural_map_residual(p, rep.lambda);
+  rep.converged = rep.residual <= tolerance;
+  rep.states = classify_states(p, rep.lambda, rep.u);
+  if (sweeps_used > 0)
+    why += ", Gauss-Seidel restarts " + std::to_string(sweeps_used);
+  rep.attempts.push_back("newton_ac: " + std::string(rep.converged ? "converged" : "not converged")
+                         + " in " + std::to_string(it) + " iterations, residual "
+                         + std::to_string(rep.residual) + why);
+}
 } // namespace
 
 SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
@@ -72,13 +231,13 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
   rep.solver = "newton_ac";
   Vector lam = lambda0.size() ? Vector(lambda0) : Vector::Zero(n);
   Vector u = p.W * lam + p.q;
-  Vector phi(n), phi_try(n), lam_try(n), u_try(n), dl(n), Wdl(n);
+  Vector phi(n), dl(n);
+  Trial trial{Vector(n), Vector(n), Vector(n), Vector(n)};
   std::vector<double> dP(static_cast<std::size_t>(m) * d * d);
   std::vector<int> closed;
   closed.reserve(m);
 
-  ac_all(p, rho, rho_t, lam, u, phi, &dP);
-  double f = 0.5 * phi.squaredNorm();
+  double f = merit(p, rho, rho_t, lam, u, phi, dP);
   double res = natural_map_residual(p, lam, u, rho);
   int it = 0;
   std::string why;
@@ -86,122 +245,43 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
   double best = res;
   // Iterations without halving the residual before Newton is declared stalled.
   constexpr int stall = 8;
-  // Non-monotone reference: the largest merit of the last few accepted iterates lets the
-  // iteration pass the shallow ridges the kinks of Φ create (Grippo–Lampariello–Lucidi).
-  std::vector<double> history{f};
-  constexpr int memory = 5;
-  constexpr double sigma = 1e-4;
+  MeritHistory history(f);
   while (res > opt.tolerance && it < opt.max_iterations)
   {
     ++it;
-    // Newton system J Δ = −Φ, J = I − D (I − ρW) = (I − D) + D ρ W with D = blockdiag(∂P/∂z).
-    // Pairs with D_k = 0 (open) have identity rows: Δ_k = −Φ_k; only the closed block is
-    // factorised, which keeps the dense LU to the size of the contact zone.
-    closed.clear();
-    for (int k = 0; k < m; ++k)
+    closed_pairs(dP, m, d, closed);
+    if (!newton_direction(p, rho, rho_t, phi, dP, closed, dl))
     {
-      const double* D = dP.data() + k * d * d;
-      bool nz = false;
-      for (int i = 0; i < d * d; ++i)
-        nz = nz || D[i] != 0.0;
-      if (nz)
-        closed.push_back(k);
+      why = ", linear system not solvable";
+      break;
     }
-    dl = -phi;
-    const int nc = static_cast<int>(closed.size());
-    if (nc > 0)
-    {
-      // Rows of the closed pairs: (I−D)_kk Δ_k + D_k ρ_k Σ_j W_kj Δ_j = −Φ_k, with Δ_open known.
-      // Since Δ = −Φ on open pairs, W_kj Δ_j for open j moves to the right-hand side; the
-      // full product WΔ₀ (Δ₀ zero on closed pairs) gives it at once.
-      Vector d0 = dl;
-      for (int k : closed)
-        d0.segment(k * d, d).setZero();
-      const Vector Wd0 = p.W * d0;
-      Matrix A(nc * d, nc * d);
-      Vector b(nc * d);
-      for (int a = 0; a < nc; ++a)
-      {
-        const int k = closed[a];
-        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
-            D(dP.data() + k * d * d, d, d);
-        Matrix Dr = D;
-        Dr.col(0) *= rho[k];
-        Dr.rightCols(d - 1) *= rho_t[k];
-        for (int c = 0; c < nc; ++c)
-          A.block(a * d, c * d, d, d).noalias() = Dr * p.W.block(k * d, closed[c] * d, d, d);
-        A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - D;
-        b.segment(a * d, d) = -phi.segment(k * d, d) - Dr * Wd0.segment(k * d, d);
-      }
-      Vector x;
-      if (!linear_solve(A, b, x))
-      {
-        why = ", linear system not solvable";
-        break;
-      }
-      for (int a = 0; a < nc; ++a)
-        dl.segment(closed[a] * d, d) = x.segment(a * d, d);
-    }
-
-    // Line search on ½‖Φ‖², Armijo with a non-monotone reference; if the Newton direction
-    // gives no decrease, the fixed-point direction −Φ (a projected step) is tried.
-    const double fref = *std::max_element(history.begin(), history.end());
-    bool accepted = false;
-    for (int attempt = 0; attempt < 2 && !accepted; ++attempt)
-    {
-      if (attempt == 1)
-        dl = -phi;
-      Wdl.noalias() = p.W * dl;
-      double alpha = 1.0;
-      for (int ls = 0; ls < 40; ++ls, alpha *= 0.5)
-      {
-        lam_try = lam + alpha * dl;
-        u_try = u + alpha * Wdl;
-        ac_all(p, rho, rho_t, lam_try, u_try, phi_try, nullptr);
-        const double ft = 0.5 * phi_try.squaredNorm();
-        if (std::isfinite(ft) && ft <= fref - 2.0 * sigma * alpha * f)
-        {
-          accepted = true;
-          break;
-        }
-      }
-    }
+    const bool accepted = line_search(p, rho, rho_t, lam, u, phi, f, history, dl, trial);
     if (!accepted || it - last_gain >= stall)
     {
-      // Stalled: a few Gauss–Seidel sweeps with exact pair solves move λ to where Newton
-      // regains its fast local convergence (they succeed where the kinks of Φ trap Newton).
+      // Stalled: the sweeps move λ to where Newton converges fast again.
       ++sweeps_used;
-      for (int s = 0; s < 5 && res > opt.tolerance; ++s)
-      {
-        detail::nsgs_sweep(p, rho, lam, u);
-        u.noalias() = p.W * lam + p.q;
-        res = natural_map_residual(p, lam, u, rho);
-      }
+      gauss_seidel_sweeps(p, rho, opt.tolerance, lam, u, res);
       if (!lam.allFinite())
       {
         why = ", non-finite iterate";
         break;
       }
-      ac_all(p, rho, rho_t, lam, u, phi, &dP);
-      f = 0.5 * phi.squaredNorm();
-      history.assign(1, f);
+      f = merit(p, rho, rho_t, lam, u, phi, dP);
+      history.reset(f);
       last_gain = it;
       best = std::min(best, res);
       if (opt.verbose)
         std::fprintf(stderr, "newton_ac it %d: Gauss-Seidel sweeps, residual %.3e\n", it, res);
       continue;
     }
-    lam.swap(lam_try);
+    lam.swap(trial.lam);
     // Recompute u now and then: the running update accumulates rounding on long runs.
     if (it % 20 == 0)
       u.noalias() = p.W * lam + p.q;
     else
-      u.swap(u_try);
-    ac_all(p, rho, rho_t, lam, u, phi, &dP);
-    f = 0.5 * phi.squaredNorm();
-    history.push_back(f);
-    if (static_cast<int>(history.size()) > memory)
-      history.erase(history.begin());
+      u.swap(trial.u);
+    f = merit(p, rho, rho_t, lam, u, phi, dP);
+    history.push(f);
     res = natural_map_residual(p, lam, u, rho);
     if (res < 0.5 * best)
     {
@@ -209,21 +289,11 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
       last_gain = it;
     }
     if (opt.verbose)
-      std::fprintf(stderr, "newton_ac it %d: closed %d, merit %.3e, residual %.3e\n", it, nc, f,
-                   res);
+      std::fprintf(stderr, "newton_ac it %d: closed %d, merit %.3e, residual %.3e\n", it,
+                   static_cast<int>(closed.size()), f, res);
   }
 
-  rep.iterations = it;
-  rep.lambda = lam;
-  rep.u = p.W * lam + p.q;
-  rep.residual = natural_map_residual(p, rep.lambda);
-  rep.converged = rep.residual <= opt.tolerance;
-  rep.states = classify_states(p, rep.lambda, rep.u);
-  if (sweeps_used > 0)
-    why += ", Gauss-Seidel restarts " + std::to_string(sweeps_used);
-  rep.attempts.push_back("newton_ac: " + std::string(rep.converged ? "converged" : "not converged")
-                         + " in " + std::to_string(it) + " iterations, residual "
-                         + std::to_string(rep.residual) + why);
+  finish_report(p, lam, it, sweeps_used, why, opt.tolerance, rep);
   return rep;
 }
 } // namespace flexcontact

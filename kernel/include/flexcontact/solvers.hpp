@@ -30,7 +30,8 @@ SolveReport solve_projection(const ProblemView& p, const Eigen::Ref<const Vector
                              const SolverOptions& opt);
 
 /// @brief Semi-smooth (generalised) Newton on the Alart–Curnier augmented Lagrangian
-/// formulation, with a line search on the natural-map merit.
+/// formulation, with a non-monotone line search on the merit ½‖Φ‖² of the Alart–Curnier
+/// function Φ and Gauss–Seidel restarts when it stalls; it stops on the natural-map residual.
 SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                             const SolverOptions& opt);
 
