@@ -13,7 +13,7 @@ block's points at (x_i, 0), the cylinder's at (x_i, g(x_i)): every slave node li
 above its master node. Outside the zone the cylinder is a circular arc and the block top a
 straight line; sizes grow from h to h_far away from the zone.
 
-For Hertz' formulas (DESIGN §5) the half-width a must be ≪ R and the block large compared
+For Hertz' formulas (docs/architecture.md §6) the half-width a must be ≪ R and the block large compared
 with a; the default W = 8R, D = 4R.
 """
 

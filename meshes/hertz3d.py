@@ -9,7 +9,7 @@ both bodies:
   the sphere z = g(r) = R − sqrt(R² − r²) (radius R, touching the block at the origin) and
   whose flat top z = H is loaded (tag LOADED). The slave surface is its bottom inside r ≤ w.
 
-The body is a sphere-ended column, not a whole sphere: Hertz' formulas (DESIGN §5) hold for
+The body is a sphere-ended column, not a whole sphere: Hertz' formulas (docs/architecture.md §6) hold for
 any bodies with that local curvature as long as the contact radius a ≪ Rc (and ≪ R).
 
 Construction: the column is meshed with a flat bottom at height z0, its bottom disc r ≤ w a

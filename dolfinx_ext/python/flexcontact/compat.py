@@ -1,7 +1,8 @@
 """Every DOLFINx call whose spelling differs between 0.5 (Debian 12) and 0.9 (Debian 13).
 
-The rest of the package calls these helpers only, so that a port is a change in this file
-(and in ``dolfinx_ext/src/compat.h`` on the C++ side).
+The rest of the package (and forms/, meshes/, the tests) calls these helpers only, so that a
+port is a change in this file. The compiled module has no DOLFINx dependency at all: it takes
+petsc4py objects and NumPy arrays (docs/architecture.md §3).
 """
 from __future__ import annotations
 
