@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+import dolfinx.fem
+
 from . import compat
 
 
@@ -32,7 +34,7 @@ def surface_nodes(V, facet_tags, value: int) -> dict:
         ValueError: if no facet carries ``value`` (the message lists the values present),
             the tags are not facet tags of V's mesh, or V is not a whole P1 space.
     """
-    if not (hasattr(V, "dofmap") and hasattr(V, "mesh")):
+    if not isinstance(V, dolfinx.fem.FunctionSpace):
         raise TypeError(f"surface_nodes: expected a dolfinx FunctionSpace, got "
                         f"{type(V).__name__}")
     msh = V.mesh
