@@ -13,7 +13,6 @@ from typing import Optional, Sequence
 import numpy as np
 from petsc4py import PETSc
 
-
 from . import _cpp, compat
 from .pairing import NodePairs
 
