@@ -19,8 +19,13 @@ packages=(
 # Siconos) skips those tests and says so.
 optional=(python3-siconos)
 
-installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
-available() { apt-cache policy "$1" 2>/dev/null | grep -q 'Candidate: [^(]'; }
+# No `cmd | grep -q` here: under pipefail, grep leaving early can SIGPIPE the command and
+# turn a match into a failure.
+installed() { [[ "$(dpkg-query -W -f='${Status}' "$1" 2>/dev/null)" == "install ok installed" ]]; }
+available() {
+  local policy; policy=$(apt-cache policy "$1" 2>/dev/null)
+  [[ $policy == *"Candidate: "* && $policy != *"Candidate: (none)"* ]]
+}
 
 SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 missing=()
@@ -33,7 +38,7 @@ fi
 for p in "${optional[@]}"; do
   installed "$p" && continue
   # Known lists say whether this distribution has it; without lists, ask the archive once.
-  if [ $updated -eq 0 ] && ! available "$p" && [ -z "$(ls /var/lib/apt/lists/ 2>/dev/null | grep -v lock)" ]; then
+  if [ $updated -eq 0 ] && ! available "$p" && ! compgen -G "/var/lib/apt/lists/*_Packages*" >/dev/null; then
     $SUDO apt-get update -qq
     updated=1
   fi

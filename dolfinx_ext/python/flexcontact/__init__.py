@@ -1,5 +1,13 @@
 """flexcontact: frictional contact and impact for FEniCSx by the condensed flexibility
 (mixed) method of Feng & Touzot."""
+from pathlib import Path as _Path
+
+# forms/ and meshes/ sit at the top of a source checkout (README, "Layout") and inside
+# the package once installed (pyproject.toml maps them). Run from a checkout, let the
+# subpackages flexcontact.forms and flexcontact.meshes be found there.
+_checkout = _Path(__file__).resolve().parents[3]
+if not (_Path(__file__).parent / "forms").is_dir() and (_checkout / "forms" / "elasticity.py").is_file():
+    __path__.append(str(_checkout))  # noqa: F821 (a package's own __path__)
 from . import _cpp  # noqa: F401  (the compiled kernel and PETSc/MUMPS bridge)
 # Errors users catch: a singular K (a body held by nothing), MUMPS or PETSc failing, no local
 # solver converging. All four are RuntimeErrors.
