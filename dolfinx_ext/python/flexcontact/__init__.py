@@ -17,11 +17,13 @@ from .boundary import dirichlet
 from .names import FLEXIBILITY_METHODS, SOLVER_NAMES, FlexibilityMethod, SolverName
 from .output import ResultWriter, results_folder, write_summary
 from .problem import ContactInterface, ContactProblem, IncrementSummary
+from .dynamics import ImpactProblem, ImpactStepRecord
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ContactInterface", "ContactProblem", "IncrementSummary", "SolverOptions",
+    "ImpactProblem", "ImpactStepRecord",
     "dirichlet", "ResultWriter", "results_folder", "write_summary",
     "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",

@@ -1,0 +1,145 @@
+"""Impact on the condensed system (docs/impact.md): the bar demos against 1D wave theory,
+conservation laws, serial against two ranks, and the bad input refused before computing.
+
+References are computed here from the formulas, with the demo's documented defaults
+(E = 200 GPa, ν = 0, ρ = 8000 kg/m³, L = 1 m, strip height H = 0.05 m, v = 1 m/s):
+contact duration 2L/c, mean force ρ c A v (wall) or ρ c A v/2 (two bars), c = sqrt(E/ρ).
+"""
+import csv
+import math
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from demo_runner import run_demo
+
+E, RHO, L, H, V0 = 200e9, 8000.0, 1.0, 0.05, 1.0
+C = math.sqrt(E / RHO)
+MASS = RHO * L * H  # per unit thickness
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("impact_serial")
+    summary, out = run_demo("bar_impact", "--no-plot", results=folder)
+    return summary, out
+
+
+def check_inputs(s):
+    assert s["material"] == {"E_Pa": E, "nu": 0.0, "rho_kg_m3": RHO}
+    assert (s["length_m"], s["height_m"], s["speed_m_s"]) == (L, H, V0)
+
+
+@pytest.mark.parametrize("case, force_ref", [("wall", RHO * C * H * V0),
+                                             ("bars", RHO * C * H * V0 / 2)])
+def test_contact_duration_and_mean_force_match_1d_waves(serial, case, force_ref):
+    s, _ = serial
+    check_inputs(s)
+    r = s[case]
+    assert r["contact_duration_s"] == pytest.approx(2 * L / C, rel=0.03)
+    assert r["mean_force"] == pytest.approx(force_ref, rel=0.05)
+
+
+def test_bar_rebounds_from_the_wall_with_its_energy(serial):
+    s, _ = serial
+    r = s["wall"]
+    assert abs(r["rebound_velocity"] - V0) <= 0.05 * V0, r["rebound_velocity"]
+    assert r["energy_before"] == pytest.approx(0.5 * MASS * V0**2, rel=1e-9)
+    assert r["energy_after"] == pytest.approx(r["energy_before"], rel=0.02)
+
+
+def test_two_bars_exchange_their_velocities(serial):
+    s, _ = serial
+    r = s["bars"]
+    assert abs(r["rebound_velocity"]) <= 0.05 * V0, r["rebound_velocity"]
+    assert abs(r["struck_velocity"] - (-V0)) <= 0.05 * V0, r["struck_velocity"]
+
+
+@pytest.mark.parametrize("case", ["wall", "bars"])
+def test_impulse_equals_change_of_momentum_and_energy_account_closes(serial, case):
+    s, _ = serial
+    r = s[case]
+    # The struck bar is a free body: the impulse it takes is its change of momentum.
+    assert r["impulse"] == pytest.approx(r["momentum_change_striker"], rel=0.01)
+    if case == "bars":
+        assert -r["impulse"] == pytest.approx(r["momentum_change_struck"], rel=0.01)
+    assert abs(r["energy_balance_error_rel"]) <= 0.01
+
+
+def test_a_step_costs_at_most_two_back_substitutions(serial):
+    s, _ = serial
+    for case in ("wall", "bars"):
+        cost = s[case]["cost"]
+        assert cost["median_without_contact"] == 1 and cost["median_with_contact"] == 2
+        assert cost["back_substitutions_per_step"] <= 2.2
+
+
+def _forces(folder, case):
+    with open(folder / "bar_impact" / f"{case}_history.csv") as fh:
+        return np.array([float(row["normal_force"]) for row in csv.DictReader(fh)])
+
+
+@pytest.mark.mpi
+def test_two_ranks_give_the_serial_answer(serial, tmp_path):
+    s, folder = serial
+    sp, _ = run_demo("bar_impact", "--no-plot", results=tmp_path, ranks=2)
+    assert sp["ranks"] == 2
+    for case in ("wall", "bars"):
+        f1, f2 = _forces(folder.parent, case), _forces(tmp_path, case)
+        assert f1.shape == f2.shape
+        assert np.max(np.abs(f1 - f2)) <= 1e-10 * s[case]["peak_force"]
+
+
+# ---- bad input ------------------------------------------------------------------------
+
+def _problem(**kw):
+    import dolfinx.fem
+    import flexcontact as fc
+    from flexcontact import compat, forms
+    from flexcontact.meshes import BASE, MASTER, SLAVE, UPPER, bar_impact
+    msh, cells, facets, geo = bar_impact.build(MPI.COMM_WORLD, n=10, ny=1, target="wall")
+    V = compat.vector_space(msh)
+    dofs = dolfinx.fem.locate_dofs_topological(V, 2, cells.indices[cells.values == BASE])
+    bcs = [dolfinx.fem.dirichletbc(np.zeros(2), dofs, V)]
+    steel = forms.Material(E_Pa=E, nu=0.0, rho_kg_m3=RHO)
+    args = dict(dt_s=0.1 / C * 0.5, initial_velocity={"bar": (-V0, 0.0)})
+    args.update(kw)
+    materials = args.pop("materials", {BASE: steel, UPPER: steel})
+    bodies = args.pop("bodies", {"wall": BASE, "bar": UPPER})
+    return fc.ImpactProblem(V, cells, bodies, materials, bcs,
+                            fc.ContactInterface(facets, SLAVE, MASTER, 0.0), **args)
+
+
+@pytest.mark.parametrize("kw, words", [
+    ({"dt_s": 0.0}, "dt_s=0.0"),
+    ({"dt_s": -1e-6}, "dt_s=-1e-06"),
+    ({"dt_s": float("nan")}, "dt_s=nan"),
+    ({"restitution": 1.5}, "restitution=1.5"),
+    ({"restitution": -0.1}, "restitution=-0.1"),
+    ({"initial_velocity": {"log": (1.0, 0.0)}}, "'log'"),
+])
+def test_bad_scheme_parameters_are_named(kw, words):
+    with pytest.raises(ValueError, match=words.replace("(", r"\(")):
+        _problem(**kw)
+
+
+def test_a_massless_body_is_refused():
+    from flexcontact import forms
+    from flexcontact.meshes import BASE, UPPER
+    steel = forms.Material(E_Pa=E, nu=0.0, rho_kg_m3=RHO)
+    light = forms.Material(E_Pa=E, nu=0.0, rho_kg_m3=0.0, name="foam")
+    with pytest.raises(ValueError, match=r"body 'bar'.*rho_kg_m3=0\.0.*no mass"):
+        _problem(materials={BASE: steel, UPPER: light})
+    with pytest.raises(ValueError, match=r"body 'ghost': no cell carries the tag 7"):
+        _problem(bodies={"wall": BASE, "bar": UPPER, "ghost": 7},
+                 materials={BASE: steel, UPPER: steel, 7: steel})
+
+
+def test_a_time_step_too_long_for_the_contact_names_the_step_to_use():
+    t_c = 2 * L / C
+    with pytest.raises(ValueError, match=r"dt_s=0\.0001 cannot resolve the contact.*"
+                                         r"use dt_s <= 4e-05") as err:
+        _problem(dt_s=1e-4)
+    # The estimate is the bar's 2L/c; the wall is rigid and does not count.
+    assert f"{t_c:.3g} s" in str(err.value)
