@@ -100,8 +100,8 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
   x0_ = initial_gap(pairs_, X_);
   W_ = delassus(B_, F_);
-  last_P_ = Vector::Zero(pairs() * dim_);
-  last_states_.assign(pairs(), PairState::open);
+  last_P_ = Vector::Zero(static_cast<Eigen::Index>(pairs_.size()) * dim_);
+  last_states_.assign(pairs_.size(), PairState::open);
 }
 
 void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)

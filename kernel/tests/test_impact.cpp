@@ -27,7 +27,7 @@ constexpr double m = 2.0, k = 800.0, L = 1.0;
 const std::vector<int> contact_dofs{0, 1, 4, 5};
 const std::vector<bool> wall_held{false, false, true, true};
 
-struct Run
+struct ImpactRun
 {
   Vector u, v;                   ///< final state
   double impulse_x = 0.0;        ///< Σ of the slave impulses along x (on the masses)
@@ -43,7 +43,7 @@ double energy(const Matrix& M, const Matrix& K, const Vector& u, const Vector& v
 
 /// @brief Integrates the θ = ½ scheme for `steps` steps of size h from v0 on both masses
 /// (spring on: the mass–spring; spring off and back mass far: a single mass).
-Run integrate(double h, int steps, const Vector& v0, double e, double mu, double kk = k)
+ImpactRun integrate(double h, int steps, const Vector& v0, double e, double mu, double kk = k)
 {
   const double theta = 0.5;
   Matrix M = Matrix::Zero(6, 6), K = Matrix::Zero(6, 6);
@@ -62,7 +62,7 @@ Run integrate(double h, int steps, const Vector& v0, double e, double mu, double
   ImpactContact c(2, F, X, {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))}, vec({mu}), e, h, theta,
                   wall_held);
 
-  Run r;
+  ImpactRun r;
   Vector u = Vector::Zero(6), v = Vector::Zero(6);
   u[2] = 0.0; // the back node's displacement; its position is L
   v.head(4) << v0[0], v0[1], v0[0], v0[1];
@@ -108,7 +108,7 @@ TEST(Impact, MassSpringOnAWallLosesTheFrontMassEnergyAndBouncesOff)
   // leaves with the back mass at v: 3 m v in all, and ½ m v² of the m v² is lost.
   const double v = 1.5, omega = std::sqrt(k / m), tc = std::numbers::pi / omega;
   const double h = tc / 400;
-  const Run r = integrate(h, 600, vec({-v, 0.0}), 0.0, 0.0);
+  const ImpactRun r = integrate(h, 600, vec({-v, 0.0}), 0.0, 0.0);
   EXPECT_NEAR(r.impulse_x, 3 * m * v, 1e-3 * m * v);
   // Impulse = change of momentum, exactly for the scheme (K's rows sum to zero).
   EXPECT_NEAR(r.impulse_x, m * (r.v[0] + r.v[2]) - m * (-2 * v), 1e-10 * m * v);
@@ -123,7 +123,7 @@ TEST(Impact, RestitutionSetsTheReboundOfASingleMass)
   // No spring: the front mass alone. U_n⁺ = −e U_n⁻, and with e = 1 no energy is lost.
   for (double e : {0.0, 0.5, 1.0})
   {
-    const Run r = integrate(1e-3, 20, vec({-2.0, 0.0}), e, 0.0, 0.0);
+    const ImpactRun r = integrate(1e-3, 20, vec({-2.0, 0.0}), e, 0.0, 0.0);
     EXPECT_NEAR(r.v[0], 2.0 * e, 1e-12) << "e = " << e;
     EXPECT_NEAR(r.impulse_x, m * 2.0 * (1 + e), 1e-12) << "e = " << e;
     EXPECT_NEAR(r.energy - r.energy0, r.contact_work, 1e-12 * r.energy0) << "e = " << e;
@@ -135,14 +135,14 @@ TEST(Impact, FrictionImpulseIsMuTimesNormalWhileSliding)
   // A single mass hits the wall obliquely, fast along the wall: it slides throughout, so
   // P_t = μ P_n and the tangential speed drops by μ (1 + e) v_n. Friction dissipates.
   const double vn = 1.0, vt = 3.0, mu = 0.3, e = 0.5;
-  const Run r = integrate(1e-3, 20, vec({-vn, vt}), e, mu, 0.0);
+  const ImpactRun r = integrate(1e-3, 20, vec({-vn, vt}), e, mu, 0.0);
   EXPECT_NEAR(r.v[0], e * vn, 1e-12);
   EXPECT_NEAR(r.v[1], vt - mu * (1 + e) * vn, 1e-9);
   EXPECT_NEAR(r.impulse_x, m * vn * (1 + e), 1e-12);
   EXPECT_LT(r.friction_work, 0.0);
   EXPECT_NEAR(r.energy - r.energy0, r.contact_work, 1e-12 * r.energy0);
   // Slow along the wall: it sticks, and the tangential velocity stops.
-  const Run s = integrate(1e-3, 20, vec({-vn, 0.1}), e, mu, 0.0);
+  const ImpactRun s = integrate(1e-3, 20, vec({-vn, 0.1}), e, mu, 0.0);
   EXPECT_NEAR(s.v[1], 0.0, 1e-9);
 }
 
