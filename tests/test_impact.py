@@ -143,3 +143,24 @@ def test_a_time_step_too_long_for_the_contact_names_the_step_to_use():
         _problem(dt_s=1e-4)
     # The estimate is the bar's 2L/c; the wall is rigid and does not count.
     assert f"{t_c:.3g} s" in str(err.value)
+
+
+def test_readme_impact_example_runs(tmp_path):
+    """The README's impact example (its second Python block, after the first one's imports)
+    runs as written and closes its energy account."""
+    import os
+    import re
+    import subprocess
+    from conftest import ROOT
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+    imports = "\n".join(l for l in blocks[0].splitlines() if l.startswith(("from ", "import ")))
+    script = tmp_path / "impact_example.py"
+    script.write_text(imports + "\n" + blocks[1])
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(ROOT / "dolfinx_ext" / "python")
+    out = subprocess.run(["/usr/bin/python3", str(script)], cwd=tmp_path, env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]
+    balance = float(out.stdout.split()[-1])
+    assert abs(balance) < 1e-10
+    assert (tmp_path / "results" / "bar" / "bar.xdmf").exists()

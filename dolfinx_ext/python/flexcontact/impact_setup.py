@@ -107,8 +107,11 @@ def make_bodies(V, cell_tags, bodies: dict, materials: dict, held_marker: PETSc.
         lo = x.min(axis=0) if len(x) else np.full(gdim, np.inf)
         hi = x.max(axis=0) if len(x) else np.full(gdim, -np.inf)
         free = int(sum(marker[d].sum() for d in dofs))
-        out.append(Body(name, tag, mat, dofs, blocks,
-                        comm.allreduce(lo, op=MPI.MIN), comm.allreduce(hi, op=MPI.MAX),
+        # Buffer reductions: the pickle-based allreduce would compare arrays with min().
+        lo, hi = np.ascontiguousarray(lo, float), np.ascontiguousarray(hi, float)
+        comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+        comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
+        out.append(Body(name, tag, mat, dofs, blocks, lo, hi,
                         comm.allreduce(free, op=MPI.SUM)))
     return out
 
