@@ -122,7 +122,8 @@ def summarise(case, target, problem, records, dt, comm):
         write_history_csv(folder / f"{case}_history.csv", records, e.initial)
         if not args.no_plot:
             plot_history(folder / f"{case}.png", records, f"bar on {target}",
-                         s["mean_force_ref"], 2 * L / c, m["contact_start_s"] or 0.0)
+                         s["mean_force_ref"], 2 * L / c, m["contact_start_s"] or 0.0,
+                         force_unit="N/m", energy_unit="J/m")
         print(f"{case}: duration {s['contact_duration_s']:.4e} s (2L/c {2 * L / c:.4e}), "
               f"mean force {s['mean_force']:.4e} (ref {s['mean_force_ref']:.4e}), "
               f"rebound {s['rebound_velocity']:+.4f} m/s, energy {e.initial:.4e} -> "

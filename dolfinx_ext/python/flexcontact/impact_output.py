@@ -56,8 +56,9 @@ def write_history_csv(path: Union[str, os.PathLike], records: Sequence, energy0:
 
 def plot_history(path: Union[str, os.PathLike], records: Sequence, title: str,
                  force_ref: float = None, duration_ref: float = None,
-                 start_s: float = 0.0) -> None:
-    """Contact force and energies against time, one PNG with two panels."""
+                 start_s: float = 0.0, force_unit: str = "N", energy_unit: str = "J") -> None:
+    """Contact force and energies against time, one PNG with two panels (units as given:
+    per unit thickness in 2D)."""
     from .output import pyplot
     plt = pyplot()
     t = np.array([r.t_s for r in records]) * 1e3
@@ -67,7 +68,7 @@ def plot_history(path: Union[str, os.PathLike], records: Sequence, title: str,
         a1.plot(np.array([start_s, start_s, start_s + duration_ref, start_s + duration_ref])
                 * 1e3, [0, force_ref, force_ref, 0], "k--", lw=0.8, label="1D theory")
     a1.set_xlabel("t [ms]")
-    a1.set_ylabel("force")
+    a1.set_ylabel(f"contact force [{force_unit}]")
     a1.set_title(title)
     a1.legend()
     a1.grid(alpha=0.3)
@@ -75,7 +76,7 @@ def plot_history(path: Union[str, os.PathLike], records: Sequence, title: str,
                        ("friction", "--"), ("damping", "--"), ("total", "k-")):
         a2.plot(t, [r.energy[key] for r in records], style, label=key)
     a2.set_xlabel("t [ms]")
-    a2.set_ylabel("energy")
+    a2.set_ylabel(f"energy [{energy_unit}]")
     a2.legend(fontsize=8)
     a2.grid(alpha=0.3)
     fig.tight_layout()
