@@ -93,7 +93,7 @@ def test_two_ranks_give_the_serial_answer(serial, tmp_path):
 
 # ---- bad input ------------------------------------------------------------------------
 
-def _problem(**kw):
+def _problem(mu=0.0, **kw):
     import dolfinx.fem
     import flexcontact as fc
     from flexcontact import compat, forms
@@ -108,7 +108,26 @@ def _problem(**kw):
     materials = args.pop("materials", {BASE: steel, UPPER: steel})
     bodies = args.pop("bodies", {"wall": BASE, "bar": UPPER})
     return fc.ImpactProblem(V, cells, bodies, materials, bcs,
-                            fc.ContactInterface(facets, SLAVE, MASTER, 0.0), **args)
+                            fc.ContactInterface(facets, SLAVE, MASTER, mu), **args)
+
+
+def test_sliding_impact_takes_mu_times_the_normal_impulse():
+    """A bar hitting the wall fast along it slides throughout: Coulomb on impulses gives a
+    tangential impulse of μ times the normal one, and friction dissipates energy that the
+    account books."""
+    mu, vn, vt = 0.3, 1.0, 5.0
+    p = _problem(mu=mu, initial_velocity={"bar": (-vn, vt)})
+    records = p.run(1.5 * 2 * L / C, progress=False)
+    Pn = sum(r.impulse[0] for r in records)
+    Pt = sum(r.impulse[1] for r in records)
+    assert Pn > 0
+    assert -Pt == pytest.approx(mu * Pn, rel=0.01)  # opposes the +y sliding
+    assert all(r.stick == 0 for r in records)
+    assert p.energy.friction > 0.01 * p.energy.initial
+    assert abs(p.energy.balance_error_rel) <= 0.01
+    # The bar's momentum along the wall drops by the friction impulse.
+    dp = records[-1].momentum["bar"][1] - p.momentum0["bar"][1]
+    assert dp == pytest.approx(Pt, rel=0.01)
 
 
 @pytest.mark.parametrize("kw, words", [
@@ -118,6 +137,11 @@ def _problem(**kw):
     ({"restitution": 1.5}, "restitution=1.5"),
     ({"restitution": -0.1}, "restitution=-0.1"),
     ({"initial_velocity": {"log": (1.0, 0.0)}}, "'log'"),
+    ({"initial_velocity": {"bar": (1.0, 0.0, 0.0)}}, r"initial_velocity\['bar'\]"),
+    ({"theta": 0.4}, "theta=0.4"),
+    ({"rayleigh": (-1.0, 0.0)}, "rayleigh alpha=-1.0"),
+    ({"mass": "diagonal"}, "mass='diagonal'"),
+    ({"expected_contact_s": 0.0}, "expected_contact_s=0.0"),
 ])
 def test_bad_scheme_parameters_are_named(kw, words):
     with pytest.raises(ValueError, match=words.replace("(", r"\(")):
