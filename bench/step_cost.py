@@ -19,7 +19,6 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-import dolfinx.fem
 import flexcontact as fc
 from flexcontact import compat, forms
 from flexcontact.impact_output import cost_summary
@@ -40,8 +39,7 @@ rows = []
 for n in args.n:
     msh, cells, facets, geo = bar_impact.build(comm, length=L, n=n, ny=args.ny, target="wall")
     V = compat.vector_space(msh)
-    dofs = dolfinx.fem.locate_dofs_topological(V, 2, cells.indices[cells.values == BASE])
-    bcs = [dolfinx.fem.dirichletbc(np.zeros(2), dofs, V)]
+    bcs = fc.hold_body(V, cells, BASE)
     dt = geo["h"] / c
     t0 = time.perf_counter()
     p = fc.ImpactProblem(V, cells, {"wall": BASE, "bar": UPPER}, {BASE: steel, UPPER: steel},

@@ -21,7 +21,6 @@ import argparse
 import math
 import time
 
-import numpy as np
 from mpi4py import MPI
 
 import flexcontact as fc
@@ -64,11 +63,7 @@ def run(case):
     V = compat.vector_space(msh)
     bcs = []
     if case == "wall":
-        # Every node of the wall's cells is held: the wall is rigid.
-        import dolfinx.fem
-        wall_cells = cells.indices[cells.values == BASE]
-        dofs = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim, wall_cells)
-        bcs = [dolfinx.fem.dirichletbc(np.zeros(2, dtype=np.float64), dofs, V)]
+        bcs = fc.hold_body(V, cells, BASE)  # every node of the wall held: rigid
     dt = args.courant * geo["h"] / c
     problem = fc.ImpactProblem(
         V, cells, {target: BASE, "striker": UPPER}, {BASE: steel, UPPER: steel}, bcs,
