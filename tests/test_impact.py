@@ -206,3 +206,20 @@ def test_readme_impact_example_runs(tmp_path):
     balance = float(out.stdout.split()[-1])
     assert abs(balance) < 1e-10
     assert (tmp_path / "results" / "bar" / "bar.xdmf").exists()
+
+
+def test_sphere_impact_matches_hertz(tmp_path):
+    """Hertz impact of a sphere-ended column on a block (3D quarter model): contact duration
+    t_c = 2.87 (m²/(R E*² v))^(1/5) and peak force (4/3) E* √R δ_max^(3/2), δ_max =
+    (15 m v²/(16 E* √R))^(2/5), each within 10%; recomputed here from the run's m, R, v."""
+    s, _ = run_demo("sphere_impact", "--no-plot", results=tmp_path)
+    assert s["material"] == {"E_Pa": 200e9, "nu": 0.3, "rho_kg_m3": 7850.0}
+    Estar = 1.0 / (2 * (1 - 0.3**2) / 200e9)
+    m, R, v = s["mass_kg"], s["R_m"], s["speed_m_s"]
+    t_c = 2.87 * (m**2 / (R * Estar**2 * v)) ** 0.2
+    d_max = (15 * m * v**2 / (16 * Estar * math.sqrt(R))) ** 0.4
+    F_max = 4 / 3 * Estar * math.sqrt(R) * d_max**1.5
+    assert s["contact_duration_s"] == pytest.approx(t_c, rel=0.10)
+    assert s["peak_force"] == pytest.approx(F_max, rel=0.10)
+    assert s["impulse"] == pytest.approx(s["momentum_change"], rel=0.01)
+    assert abs(s["energy_balance_error_rel"]) <= 0.01
