@@ -178,6 +178,15 @@ def test_a_massless_body_is_refused():
                  materials={BASE: steel, UPPER: steel, 7: steel})
 
 
+def test_holding_a_body_with_no_cells_names_the_tag():
+    import flexcontact as fc
+    from flexcontact import compat
+    from flexcontact.meshes import bar_impact
+    msh, cells, _, _ = bar_impact.build(MPI.COMM_WORLD, n=4, ny=1)
+    with pytest.raises(ValueError, match="no cell carries the tag value 99"):
+        fc.hold_body(compat.vector_space(msh), cells, 99)
+
+
 def test_a_time_step_too_long_for_the_contact_names_the_step_to_use():
     t_c = 2 * L / C
     with pytest.raises(ValueError, match=r"dt_s=0\.0001 cannot resolve the contact.*"
