@@ -92,6 +92,29 @@ class BaseSection:
                 "sigma_heel_Pa": self.sigma_heel_Pa, "sigma_toe_Pa": self.sigma_toe_Pa}
 
 
+def nodal_forces(V, form, facet_tags=None, tag=None) -> tuple[np.ndarray, np.ndarray]:
+    """Assemble the linear ``form`` and return this rank's owned nodal forces (n, gdim) and
+    their points (n, gdim), on the nodes of facets tagged ``tag`` (all nodes if None)."""
+    import dolfinx.fem
+    import dolfinx.fem.petsc
+    msh = V.mesh
+    r = compat.create_petsc_vector(V)
+    r.zeroEntries()
+    dolfinx.fem.petsc.assemble_vector(r, form)
+    r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    n_owned = V.dofmap.index_map.size_local
+    if tag is None:
+        owned = np.arange(n_owned, dtype=np.int32)
+    else:
+        facets = facet_tags.indices[facet_tags.values == tag]
+        blocks = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim - 1, facets)
+        owned = blocks[blocks < n_owned]
+    gdim = msh.geometry.dim
+    values = r.array_r.reshape(-1, gdim)[owned].copy()
+    r.destroy()
+    return V.tabulate_dof_coordinates()[owned, :gdim], values
+
+
 def nodal_section(V, residual_form, facet_tags, base_tag: int, base_width_m: float,
                   width_m: float = 1.0) -> BaseSection:
     """Base section from the nodal forces of one side's residual at the base nodes.
@@ -101,22 +124,8 @@ def nodal_section(V, residual_form, facet_tags, base_tag: int, base_width_m: flo
     force the dam hands to the foundation there, and elsewhere it vanishes; the sums are
     those of the loads on the dam, exact in statics whatever the mesh. Collective.
     """
-    import dolfinx.fem
-    import dolfinx.fem.petsc
-    msh = V.mesh
-    r = compat.create_petsc_vector(V)
-    r.zeroEntries()
-    dolfinx.fem.petsc.assemble_vector(r, residual_form)
-    r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    fdim = msh.topology.dim - 1
-    facets = facet_tags.indices[facet_tags.values == base_tag]
-    blocks = dolfinx.fem.locate_dofs_topological(V, fdim, facets)
-    owned = blocks[blocks < V.dofmap.index_map.size_local]
-    gdim = msh.geometry.dim
-    values = r.array_r.reshape(-1, gdim)[owned]
-    points = V.tabulate_dof_coordinates()[owned, :gdim]
-    r.destroy()
-    return BaseSection.from_forces(points, values, base_width_m, width_m, comm=msh.comm)
+    points, values = nodal_forces(V, residual_form, facet_tags, base_tag)
+    return BaseSection.from_forces(points, values, base_width_m, width_m, comm=V.mesh.comm)
 
 
 def sample_directions(dim: int, n: int) -> np.ndarray:

@@ -182,3 +182,20 @@ def _sections(s, V, uh, loads, dx, kind, mesh):
             sec = sec.plus(up, point)
         out.append(sec)
     return out
+
+
+def upstream_water_resultant(result: Stage1Result) -> tuple[float, float]:
+    """The finite-element reservoir load on the upstream face: its downstream force (N/m in
+    2D, N in 3D) and the height above the base where it acts (m), from the assembled nodal
+    loads. Collective."""
+    from .section import nodal_forces, tipping_moment
+    s, V = result.scenario, result.V
+    v = ufl.TestFunction(V)
+    _, ds = _measures(result.mesh)
+    L = hydrostatic_pressure(v, ds(T.DAM_UPSTREAM), s.water_level_m, s.water_density_kg_m3,
+                             s.gravity_m_s2, s.vertical_axis)
+    points, forces = nodal_forces(V, dolfinx.fem.form(L))
+    comm = V.mesh.comm
+    force = comm.allreduce(float(forces[:, 0].sum()), op=MPI.SUM)
+    moment = comm.allreduce(float(tipping_moment(points, forces).sum()), op=MPI.SUM)
+    return force, moment / force
