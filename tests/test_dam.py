@@ -103,6 +103,19 @@ def test_log_elevation_follows_its_draft():
     assert lighter.log_axis_elevation_m > s.log_axis_elevation_m  # a lighter log rides higher
 
 
+def test_westergaard_added_mass_integrates_to_seven_twelfths():
+    from flexcontact.dam import westergaard_added_mass_kg_m2
+    h = 27.0
+    # ∫0^h (7/8) ρ sqrt(h (h − y)) dy = (7/12) ρ h²; substitute y = h (1 − t²) so that the
+    # integrand is smooth: (7/4) ρ h² ∫0^1 t² dt, Gauss-Legendre exact.
+    t, w = np.polynomial.legendre.leggauss(8)
+    t, w = 0.5 * (t + 1), 0.5 * w
+    depth = h * t ** 2
+    total = np.sum(w * westergaard_added_mass_kg_m2(depth, h) * 2 * h * t)
+    assert abs(total / (7 / 12 * RHO_W * h ** 2) - 1) < 1e-12
+    assert westergaard_added_mass_kg_m2(-1.0, h) == 0.0  # above the water
+
+
 # ---- the mesh ----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def stage1_2d():
