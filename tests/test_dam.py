@@ -5,7 +5,6 @@ References are computed here from textbook statics: the dam's weight from the tr
 decomposition of its profile, the hydrostatic resultant ρ_w g h²/2 at h/3, the tailwater's
 horizontal thrust and the weight of the water wedge over the downstream slope, the uplift
 trapezoid; the linearised base stresses σ = −N/B ± 6 M_c/B²."""
-import json
 import math
 
 import numpy as np
@@ -18,7 +17,7 @@ from demo_runner import run_demo
 from flexcontact import compat
 from flexcontact.dam import DamScenario, WOOD, floating_draft_m
 from flexcontact.dam.section import peak_at_offset
-from flexcontact.dam.stage1 import build_mesh, solve_stage1, upstream_water_resultant
+from flexcontact.dam.stage1 import solve_stage1, upstream_water_resultant
 from flexcontact.forms import Material
 from flexcontact.meshes import _gmsh
 from flexcontact.meshes import dam_tags as T

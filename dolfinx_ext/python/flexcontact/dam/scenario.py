@@ -31,7 +31,6 @@ driven sideways would need about 1.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass, fields, replace
 from typing import Optional
 
@@ -49,10 +48,6 @@ WOOD = Material(E_Pa=10e9, nu=0.3, rho_kg_m3=650.0, name="wood")
 """Green softwood log, isotropic with the along-grain modulus."""
 
 _DEFAULT_MESH = {2: (3.0, 0.2), 3: (6.0, 0.4)}  # (far, impact) element sizes in m by dimension
-
-
-def _is_real(x) -> bool:
-    return isinstance(x, numbers.Real) and not isinstance(x, bool) and math.isfinite(x)
 
 
 @dataclass(frozen=True)
