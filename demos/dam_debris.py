@@ -94,6 +94,12 @@ if s.dim == 2 and not args.no_plot:
     plot_groups(stage1.mesh, folder / "geometry.png", s)
 
 # %% [markdown]
+# The heel is a re-entrant corner (the upstream face meets the reservoir bed): the stress
+# there grows without bound under refinement, which is why engineers read the linearised
+# heel stress. The largest principal stress at `--offset` from the heel converges instead,
+# slowly: at the default size the offset lies inside the first element, so compare
+# `--refine 1` and `--refine 2` before trusting it.
+#
 # ## Summary
 # Forces per metre of dam in 2D (N/m, N·m/m), for the whole block in 3D (N, N·m); stresses
 # in Pa, tension positive. Each `q` has its hand-statics reference `q_ref`.
