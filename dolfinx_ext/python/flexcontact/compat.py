@@ -170,3 +170,27 @@ def create_petsc_vector(V):
     """A ghosted PETSc vector laid out like the Function space's DOFs."""
     import dolfinx.la
     return dolfinx.la.create_petsc_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+
+
+def points_in_cells(msh, points) -> tuple[np.ndarray, np.ndarray]:
+    """Which of ``points`` (n, 3) lie in this rank's cells: (point indices, one cell each).
+
+    A point on a cell boundary is given one of its cells; points outside every local cell
+    (owned or ghost) are left out."""
+    import dolfinx.geometry as geometry
+    tdim = msh.topology.dim
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+    if NEW_API:
+        tree = geometry.bb_tree(msh, tdim)
+        candidates = geometry.compute_collisions_points(tree, points)
+    else:
+        tree = geometry.BoundingBoxTree(msh, tdim)
+        candidates = geometry.compute_collisions(tree, points)
+    colliding = geometry.compute_colliding_cells(msh, candidates, points)
+    found, cells = [], []
+    for i in range(points.shape[0]):
+        links = colliding.links(i)
+        if len(links):
+            found.append(i)
+            cells.append(links[0])
+    return np.array(found, dtype=np.int64), np.array(cells, dtype=np.int32)
