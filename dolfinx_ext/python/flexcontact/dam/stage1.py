@@ -113,7 +113,9 @@ def hold_log(V, mesh: DamMesh):
     """Zero displacement on every DOF of the log's cells."""
     msh = mesh.msh
     cells = mesh.cell_tags.indices[mesh.cell_tags.values == T.LOG]
-    dofs = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim, cells)
+    tdim = msh.topology.dim
+    msh.topology.create_connectivity(tdim, tdim)  # DOLFINx 0.9 needs it for cell entities
+    dofs = dolfinx.fem.locate_dofs_topological(V, tdim, cells)
     zero = dolfinx.fem.Constant(msh, PETSc.ScalarType((0.0,) * msh.geometry.dim))
     return dolfinx.fem.dirichletbc(zero, dofs, V)
 
