@@ -42,7 +42,7 @@ def test_hertz_half_width_and_peak_pressure(hertz):
     assert rms < 0.05
     assert s["pressure_rms_error_rel_p0"] == pytest.approx(rms, rel=1e-10, abs=0)
     assert s["max_penetration_rel"] <= 1e-8
-    assert (folder / "hertz2d.xdmf").exists() and (folder / "hertz2d.h5").exists()
+    assert (folder / "hertz2d.xdmf").exists() and (folder / "hertz2d.bin").exists()
     assert (folder / "hertz2d.png").stat().st_size > 10_000
 
 

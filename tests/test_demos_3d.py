@@ -53,7 +53,7 @@ def test_hertz3d_radius_and_peak_pressure(hertz):
     assert s["P_target"] == pytest.approx(P_target, rel=1e-12, abs=0)
     assert s["P"] == pytest.approx(P_target, rel=0.05)
     assert s["max_penetration_rel"] <= 1e-8
-    assert (folder / "hertz3d.xdmf").exists() and (folder / "hertz3d.h5").exists()
+    assert (folder / "hertz3d.xdmf").exists() and (folder / "hertz3d.bin").exists()
     assert (folder / "hertz3d.png").stat().st_size > 10_000
 
 
