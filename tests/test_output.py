@@ -3,7 +3,10 @@
 The file is read back with plain Python (xml.etree and NumPy), and the values compared with
 the formulas the fields were interpolated from, evaluated at the written coordinates.
 """
+import json
 import math
+import shutil
+import subprocess
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -180,3 +183,29 @@ def test_two_ranks_write_the_serial_file(tmp_path):
                 np.testing.assert_array_equal(v1, v2)
             else:
                 assert close(v2, v1), name
+
+
+@pytest.mark.skipif(shutil.which("pvbatch") is None,
+                    reason="ParaView's pvbatch not installed (Debian package paraview)")
+def test_paraview_warps_and_colours_one_dataset(tmp_path):
+    path = write_2d(tmp_path, MPI.COMM_WORLD)
+    proc = subprocess.run(["pvbatch", str(ROOT / "tests" / "paraview_check.py"), str(path),
+                           "displacement", "cellx"], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    last = read(path)[-1]
+    # One dataset (no multiblock to extract and merge), every field double precision.
+    assert seen["class"] == "vtkUnstructuredGrid" and seen["times"] == list(TIMES)
+    assert (seen["points"], seen["cells"]) == (len(last["x"]), len(last["cells"]))
+    kinds = {name: (assoc, cls) for name, assoc, cls, _ in seen["arrays"]}
+    for name, assoc in (("x2", "POINTS"), ("displacement", "POINTS"), ("cellx", "CELLS")):
+        assert kinds[name][0] == assoc, (name, kinds[name])
+        assert kinds[name][1] in ("vtkTypeFloat64Array", "vtkDoubleArray"), (name, kinds[name])
+    assert seen["point_type"] in ("vtkTypeFloat64Array", "vtkDoubleArray")
+    # Warp By Vector moved every node by its written displacement.
+    moved = last["x"] + last["attributes"]["displacement"][3]
+    bounds = np.column_stack([moved.min(axis=0), moved.max(axis=0)]).ravel()
+    np.testing.assert_allclose(seen["warped_bounds"], bounds, rtol=0, atol=1e-14 * 2.5)
+    cx = last["attributes"]["cellx"][3]
+    np.testing.assert_allclose(seen["field_range"], [cx.min(), cx.max()], rtol=1e-15)

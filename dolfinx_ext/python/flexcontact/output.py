@@ -28,7 +28,7 @@ class ResultWriter:
     The file is complete after every step, so a failing increment leaves a readable file with
     the increments done before it; use as a context manager all the same, so that the data
     file is closed. Cell tags (``tags``) are written at every step as integer cell attributes
-    (``cell_tag`` for DOLFINx's default name, else the tags' name). Collective on the mesh's
+    (``cell_tag`` for DOLFINx's default names, else the tags' name). Collective on the mesh's
     communicator; rank 0 writes, and the file is the same on any number of ranks.
     """
 

@@ -23,6 +23,10 @@ TOPOLOGY_TYPES = {
 }
 
 
+# Names DOLFINx gives tags by itself (meshtags, gmshio.model_to_mesh): written as "cell_tag".
+DEFAULT_TAG_NAMES = ("mesh_tags", "Cell tags", "")
+
+
 def raise_on_any_rank(comm, message: Optional[str], error=ValueError) -> None:
     """Raise ``error(message)`` on every rank if any rank has a message (collective)."""
     messages = [m for m in comm.allgather(message) if m]
@@ -151,7 +155,7 @@ class MeshGather:
                            f"tags (dimension {tdim}) are written")
         raise_on_any_rank(self.comm, message)
         out = []
-        names = ["cell_tag" if t.name in ("mesh_tags", "") else t.name for t in tags]
+        names = ["cell_tag" if t.name in DEFAULT_TAG_NAMES else t.name for t in tags]
         for i, t in enumerate(tags):
             own = t.indices < self.n_owned_cells
             parts = self.comm.gather((self.cell_ids[t.indices[own]], t.values[own]), root=0)
