@@ -47,7 +47,7 @@ class XdmfSeries:
         self._static = [(name, "Cell", "Scalar", self._append(np.asarray(v, dtype="<i4")))
                         for name, v in static]
         self._bin.flush()
-        self._steps: list[tuple[float, list]] = []
+        self._grids: list[bytes] = []   # each step's Grid, serialized once
         self._write_xml()
 
     def _append(self, a: np.ndarray) -> dict:
@@ -65,7 +65,7 @@ class XdmfSeries:
         attributes = [(f.name, f.center, _attribute_type(f.values),
                        self._append(np.asarray(f.values, dtype="<f8"))) for f in fields]
         self._bin.flush()
-        self._steps.append((t, attributes))
+        self._grids.append(self._grid(t, attributes))
         self._write_xml()
 
     def close(self) -> None:
@@ -75,8 +75,8 @@ class XdmfSeries:
     def _data_item(self, parent, item: dict) -> None:
         ET.SubElement(parent, "DataItem", item).text = self.bin_path.name
 
-    def _grid(self, collection, t: float, attributes) -> None:
-        grid = ET.SubElement(collection, "Grid", Name="mesh", GridType="Uniform")
+    def _grid(self, t: float, attributes) -> bytes:
+        grid = ET.Element("Grid", Name="mesh", GridType="Uniform")
         ET.SubElement(grid, "Time", Value=repr(float(t)))
         topo = ET.SubElement(grid, "Topology", TopologyType=self.topology_type,
                              NumberOfElements=str(self.n_cells),
@@ -86,18 +86,15 @@ class XdmfSeries:
         for name, center, kind, item in self._static + attributes:
             attr = ET.SubElement(grid, "Attribute", Name=name, AttributeType=kind, Center=center)
             self._data_item(attr, item)
+        ET.indent(grid, space="  ", level=3)
+        return b"      " + ET.tostring(grid) + b"\n"
 
     def _write_xml(self) -> None:
-        root = ET.Element("Xdmf", Version="3.0")
-        domain = ET.SubElement(root, "Domain")
-        collection = ET.SubElement(domain, "Grid", Name="TimeSeries", GridType="Collection",
-                                   CollectionType="Temporal")
-        for t, attributes in self._steps:
-            self._grid(collection, t, attributes)
-        ET.indent(root)
+        # Each step's Grid is serialized once, so a long run rewrites bytes, not trees.
+        head = (b'<?xml version="1.0"?>\n<Xdmf Version="3.0">\n  <Domain>\n'
+                b'    <Grid Name="TimeSeries" GridType="Collection" CollectionType="Temporal">\n')
+        tail = b"    </Grid>\n  </Domain>\n</Xdmf>\n"
         tmp = self.path.with_name(self.path.name + ".tmp")
         with open(tmp, "wb") as f:
-            f.write(b'<?xml version="1.0"?>\n')
-            f.write(ET.tostring(root))
-            f.write(b"\n")
+            f.write(head + b"".join(self._grids) + tail)
         os.replace(tmp, self.path)
