@@ -71,6 +71,31 @@ def test_values_equal_the_fields(tmp_path):
         assert np.allclose(np.abs(area), 1 / 72, rtol=1e-12)
 
 
+def _nearest(points, targets):
+    """Index of the nearest of ``points`` to each target, checked to be within 1e-12."""
+    d = np.linalg.norm(points[None, :, :] - targets[:, None, :], axis=2)
+    i = d.argmin(axis=1)
+    assert np.all(d[np.arange(len(targets)), i] < 1e-12)
+    return i
+
+
+def test_values_are_the_functions_own(tmp_path):
+    """Each written value is the Function's value at the DOF sitting at that node / cell."""
+    msh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 5, 5)
+    fields = fields_2d(msh, 0.7)
+    with fc.ResultWriter(tmp_path, "own", msh) as w:
+        w.write(fields, 0.7)
+    (s,) = read(tmp_path / "own.xdmf")
+    for f in fields:
+        V = f.function_space
+        bs = V.dofmap.index_map_bs
+        own = np.asarray(f.x.array).reshape(-1, bs)
+        dof_x = V.tabulate_dof_coordinates()[:len(own)]
+        center, _, _, v = s["attributes"][f.name]
+        where = s["x"] if center == "Node" else centroids(s)
+        np.testing.assert_array_equal(v[_nearest(where, dof_x), :bs], own)
+
+
 def test_3d_vector_and_hexahedra(tmp_path):
     for cell, kind, n_vert, volume in (
             (dolfinx.mesh.CellType.tetrahedron, "Tetrahedron", 4, 1 / 6 / 27),
