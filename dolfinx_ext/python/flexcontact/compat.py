@@ -152,6 +152,27 @@ def write_mesh_and_tags(xdmf, msh, tags=()):
             xdmf.write_meshtags(t)
 
 
+def input_node_indices(msh) -> np.ndarray:
+    """Index in the mesh's input of each local geometry node: the same node has the same
+    number in serial and on any number of ranks."""
+    return np.asarray(cpp(msh.geometry).input_global_indices, dtype=np.int64)
+
+
+def original_cell_indices(msh) -> np.ndarray:
+    """Index in the mesh's input of each local cell (owned first), rank-independent."""
+    return np.asarray(cpp(msh.topology).original_cell_index, dtype=np.int64)
+
+
+def same_mesh(a, b) -> bool:
+    """True if the two DOLFINx meshes are one and the same."""
+    return cpp(a.topology) is cpp(b.topology)
+
+
+def cell_type_name(msh) -> str:
+    """"triangle", "tetrahedron", "quadrilateral", ... (single cell type meshes)."""
+    return msh.topology.cell_type.name
+
+
 def locate_component_dofs(V, component: int, facet_indices):
     """Dofs of one vector component on the given facets, as DOLFINx's dirichletbc wants them."""
     fdim = V.mesh.topology.dim - 1
