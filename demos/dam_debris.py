@@ -23,10 +23,8 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-import dolfinx.io
 
 import flexcontact as fc
-from flexcontact import compat
 from flexcontact.dam import DamScenario
 from flexcontact.dam.fields import stress_fields
 from flexcontact.dam.plot import plot_groups
@@ -86,10 +84,8 @@ heel = np.zeros(s.dim)
 peak_heel, peak_where = peak_at_offset(fields[1], heel, args.offset, cells, dam_tags.DAM)
 u_max = comm.allreduce(float(np.abs(stage1.u.x.array).max(initial=0.0)), op=MPI.MAX)
 
-with dolfinx.io.XDMFFile(comm, str(folder / "stage1.xdmf"), "w") as xdmf:
-    compat.write_mesh_and_tags(xdmf, msh, [cells, facets])
-    for f in [stage1.u, *fields]:
-        xdmf.write_function(f, 0.0)
+with fc.ResultWriter(folder, "stage1", msh, tags=(cells,)) as xdmf:
+    xdmf.write([stage1.u, *fields], 0.0)
 if s.dim == 2 and not args.no_plot:
     plot_groups(stage1.mesh, folder / "geometry.png", s)
 

@@ -143,15 +143,6 @@ def facet_dim(msh) -> int:
     return msh.topology.dim - 1
 
 
-def write_mesh_and_tags(xdmf, msh, tags=()):
-    xdmf.write_mesh(msh)
-    for t in tags:
-        if NEW_API:
-            xdmf.write_meshtags(t, msh.geometry)
-        else:
-            xdmf.write_meshtags(t)
-
-
 def input_node_indices(msh) -> np.ndarray:
     """Index in the mesh's input of each local geometry node: the same node has the same
     number in serial and on any number of ranks."""
