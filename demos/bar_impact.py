@@ -71,7 +71,7 @@ def run(case):
         dt_s=dt, kind="plane_stress", initial_velocity={"striker": (-v0, 0.0)},
         mass=args.mass)
     t_end = 1.5 * 2 * L / c
-    with fc.ResultWriter(folder, f"bar_impact_{case}", msh, [cells, facets]) as out:
+    with fc.ResultWriter(folder, f"bar_impact_{case}", msh, [cells]) as out:
         records = problem.run(t_end, writer=out, write_every=args.write_every,
                               progress=args.progress or None)
     return summarise(case, target, problem, records, dt, msh.comm)

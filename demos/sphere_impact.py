@@ -75,7 +75,7 @@ problem = fc.ImpactProblem(
     dt_s=dt, kind="3d", initial_velocity={"column": (0.0, 0.0, -v0)},
     expected_contact_s=t_hertz)
 folder = fc.results_folder("sphere_impact")
-with fc.ResultWriter(folder, "sphere_impact", msh, [cells, facets]) as out:
+with fc.ResultWriter(folder, "sphere_impact", msh, [cells]) as out:
     records = problem.run(1.4 * t_hertz, writer=out, write_every=5,
                           progress=args.progress or None)
 
