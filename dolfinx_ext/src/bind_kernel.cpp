@@ -374,4 +374,5 @@ void flexcontact::bind_kernel(py::module& m)
       .def_property_readonly("W", [](const IncrementalSolver& s) { return s.W(); });
 
   bind_condensed(m);
+  bind_impact(m);
 }

@@ -16,4 +16,7 @@ void bind_kernel(pybind11::module& m);
 
 /// @brief The condensed contact problem (called by bind_kernel, after ConvergenceError).
 void bind_condensed(pybind11::module& m);
+
+/// @brief The Moreau–Jean contact step (kernel/.../impact.hpp).
+void bind_impact(pybind11::module& m);
 } // namespace flexcontact

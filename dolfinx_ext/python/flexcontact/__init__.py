@@ -13,16 +13,18 @@ from . import _cpp  # noqa: F401  (the compiled kernel and PETSc/MUMPS bridge)
 # solver converging. All four are RuntimeErrors.
 from ._cpp import (ConvergenceError, MumpsError, PetscError, SingularStiffnessError,
                    SolverOptions)
-from .boundary import dirichlet
+from .boundary import dirichlet, hold_body
 from .names import FLEXIBILITY_METHODS, SOLVER_NAMES, FlexibilityMethod, SolverName
 from .output import ResultWriter, results_folder, write_summary
 from .problem import ContactInterface, ContactProblem, IncrementSummary
+from .dynamics import ImpactProblem, ImpactStepRecord
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ContactInterface", "ContactProblem", "IncrementSummary", "SolverOptions",
-    "dirichlet", "ResultWriter", "results_folder", "write_summary",
+    "ImpactProblem", "ImpactStepRecord",
+    "dirichlet", "hold_body", "ResultWriter", "results_folder", "write_summary",
     "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",
     "__version__",

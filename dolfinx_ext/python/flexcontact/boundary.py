@@ -45,3 +45,19 @@ def dirichlet(V: FunctionSpace, facet_tags: MeshTags, value: int,
         bcs.append(dolfinx.fem.dirichletbc(k, dofs, V.sub(c)))
         consts.append(k)
     return bcs, consts
+
+
+def hold_body(V: FunctionSpace, cell_tags: MeshTags, value: int) -> list[DirichletBC]:
+    """Hold every node of the cells tagged ``value`` fixed: a rigid body (e.g. a wall an
+    impact hits). Its contact DOFs then get no flexibility, so it does not deform at all.
+    """
+    msh = V.mesh
+    tdim = msh.topology.dim
+    cells = cell_tags.indices[cell_tags.values == value]
+    from mpi4py import MPI
+    if msh.comm.allreduce(len(cells), op=MPI.SUM) == 0:
+        raise ValueError(f"hold_body: no cell carries the tag value {value}")
+    compat.create_connectivity(msh, tdim, tdim)  # DOLFINx 0.9 locates DOFs through it
+    dofs = dolfinx.fem.locate_dofs_topological(V, tdim, cells)
+    zero = np.zeros(msh.geometry.dim, dtype=PETSc.ScalarType)
+    return [dolfinx.fem.dirichletbc(zero, dofs, V)]

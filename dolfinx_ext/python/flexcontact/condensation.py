@@ -8,7 +8,7 @@ increment crosses the binding once.
 from __future__ import annotations
 
 import time
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 from petsc4py import PETSc
@@ -29,13 +29,17 @@ class Condensation:
     dim : 2 or 3.
     options : kernel SolverOptions.
     method : how F* is computed (see ``_cpp.flexibility``).
+    kernel : optional callable ``(dim, F, X, pairs, mu, constrained, options)`` building
+        the kernel object instead of ``_cpp.CondensedContact`` (the impact step builds an
+        ``_cpp.ImpactContact`` from the F̂ of its iteration matrix this way).
 
     On rank 0 ``contact`` is the kernel object and ``B``, ``W``, ``x0``, ``frames`` its
     operators as SciPy/NumPy arrays; elsewhere they are None.
     """
 
     def __init__(self, K: PETSc.Mat, bcs: Sequence, pairs: Optional[NodePairs],
-                 mu: np.ndarray, dim: int, comm, options, method: str):
+                 mu: np.ndarray, dim: int, comm, options, method: str,
+                 kernel: Optional[Callable] = None):
         self.comm = comm
         root = comm.rank == 0
         self.dofs = (pairs.dofs.reshape(-1).astype(np.int64) if root
@@ -61,8 +65,8 @@ class Condensation:
             kpairs = _cpp.pairs_from_normals(np.arange(m), np.arange(m, 2 * m)[:, None],
                                              np.ones((m, 1)), pairs.normal)
             t0 = time.perf_counter()
-            self.contact = _cpp.CondensedContact(dim, F, pairs.x, kpairs, mu, constrained,
-                                                 options)
+            build = kernel if kernel is not None else _cpp.CondensedContact
+            self.contact = build(dim, F, pairs.x, kpairs, mu, constrained, options)
             self.timings["delassus_s"] = time.perf_counter() - t0
             c = self.contact
             self.B, self.W, self.x0, self.frames = c.B, c.W, c.x0, c.frames

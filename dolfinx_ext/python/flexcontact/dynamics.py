@@ -1,0 +1,369 @@
+"""Impact: dynamic contact on the condensed system by the Moreau–Jean θ-scheme at velocity
+level, with Newton restitution and Coulomb friction on impulses (docs/impact.md).
+
+One time step of size h, with r = h [f − C v⁻ − K (u⁻ + hθ v⁻)]:
+
+1. free velocity v_free = v⁻ + Ŵ⁻¹ r (one back-substitution with the stored factor of
+   Ŵ = M + hθC + h²θ²K, factored once per time-step size);
+2. the contact impulses P from U⁺ = W_eff P + B v_free, W_eff = B Ŵ⁻¹ Bᵀ, in the kernel
+   (``_cpp.ImpactContact``; one crossing of the binding);
+3. only in steps with contact, v⁺ = v_free + Ŵ⁻¹ Bᵀ P (a second back-substitution);
+4. u⁺ = u⁻ + h (θ v⁺ + (1 − θ) v⁻).
+
+A body with no Dirichlet condition at all is fine: Ŵ is regular where K is not. Rank 0 holds
+the condensed problem, as in the static ContactProblem.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Optional, Sequence, Union
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from . import _cpp, impact_setup as setup
+from ._cpp import ConvergenceError, SolverOptions
+from .condensation import Condensation
+from .energy import EnergyAccount
+from .names import check_chain, check_flexibility_method
+from .pairing import pair_interfaces
+from .postprocess import ContactFields
+
+if TYPE_CHECKING:
+    from dolfinx.fem import DirichletBC
+    from dolfinx.mesh import MeshTags
+
+    from .problem import ContactInterface
+
+
+@dataclass
+class ImpactStepRecord:
+    """What one time step produced (every rank). Forces are impulses / h: the mean force
+    over the step [N; N/m per unit thickness in 2D]."""
+
+    step: int
+    t_s: float
+    normal_force: float
+    slave_force: list          # global axes, on the slave side
+    impulse: list              # Σ_k T_kᵀ P_k of the step [N·s]
+    active: int
+    stick: int
+    slip: int
+    open: int
+    back_substitutions: int
+    solver: str
+    iterations: int
+    max_penetration_m: float
+    energy: dict = field(default_factory=dict)
+    momentum: dict = field(default_factory=dict)  # body -> d components [N·s]
+
+
+class ImpactProblem:
+    """Dynamic frictional contact of elastic bodies by condensation (Moreau–Jean, θ = ½).
+
+    Parameters
+    ----------
+    V : vector P1 function space.
+    cell_tags : MeshTags of the cells; ``bodies`` maps body names to their tags.
+    materials : ``{cell_tag: forms.Material}``; every body needs E and a density > 0.
+    bcs : Dirichlet conditions (zero values: fixed supports). A body whose nodes are all
+        held is rigid: contact DOFs held by a condition get no flexibility.
+    contact : one ContactInterface or a list of them (node–node pairs).
+    dt_s : time step h [s], checked against the expected contact duration (at least
+        ``setup.MIN_STEPS_IN_CONTACT`` steps), estimated as the shortest 2L/c of the
+        bodies along the contact normal unless ``expected_contact_s`` is given.
+    kind : "plane_stress", "plane_strain" or "3d".
+    initial_velocity : ``{body name: (v_x, v_y[, v_z])}`` in m/s.
+    restitution : Newton's e in [0, 1] (default 0: for deformable bodies the rebound comes
+        from the elastic waves).
+    theta : θ in [½, 1]; ½ conserves energy away from contact.
+    mass : "consistent" or "lumped" (row sum).
+    rayleigh : (α, β) of C = αM + βK.
+    loads : UFL linear form of constant external loads, or None.
+    solver, flexibility : as for ContactProblem.
+    """
+
+    def __init__(self, V, cell_tags: MeshTags, bodies: dict[str, int], materials: dict,
+                 bcs: Sequence[DirichletBC],
+                 contact: Union[ContactInterface, Sequence[ContactInterface]], *,
+                 dt_s: float, kind: str = "plane_stress",
+                 initial_velocity: Optional[dict] = None, restitution: float = 0.0,
+                 theta: float = 0.5, mass: str = "consistent",
+                 rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
+                 solver: Optional[SolverOptions] = None, flexibility: str = "schur",
+                 expected_contact_s: Optional[float] = None):
+        from . import forms
+        setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
+        check_flexibility_method(flexibility)
+        if solver is not None:
+            check_chain(solver.chain)
+        self.V, self.msh = V, V.mesh
+        self.comm, self.dim = self.msh.comm, self.msh.geometry.dim
+        self.dt, self.theta, self.restitution = float(dt_s), float(theta), float(restitution)
+        self.rayleigh = tuple(float(x) for x in rayleigh)
+        self.mass_kind, self.bcs = mass, list(bcs)
+        self.interfaces = list(contact) if isinstance(contact, (list, tuple)) else [contact]
+        self.options = solver if solver is not None else SolverOptions()
+        self.timings, self.records = {}, []
+        self.t, self.back_substitutions = 0.0, 0
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        dx = ufl.Measure("dx", domain=self.msh, subdomain_data=cell_tags)
+        self.a_form = dolfinx.fem.form(forms.elasticity_form(u, v, materials, dx, kind,
+                                                             cell_tags))
+        self.m_form = dolfinx.fem.form(forms.mass_form(u, v, materials, dx))
+        t0 = time.perf_counter()
+        K_probe = dolfinx.fem.petsc.assemble_matrix(self.a_form, bcs=self.bcs)
+        K_probe.assemble()
+        self.marker = setup.held_marker(K_probe, self.bcs)
+        K_probe.destroy()
+        self.bodies = setup.make_bodies(V, cell_tags, bodies, materials, self.marker)
+        self.pairs, self.mu, self.m = pair_interfaces(V, self.interfaces, self.comm)
+        self._check_time_step(expected_contact_s)
+        self.K, self.M = setup.assemble_matrices(self.a_form, self.m_form, self.bcs, mass,
+                                                 self.marker)
+        self.f = setup.load_vector(V, dolfinx.fem.form(loads) if loads is not None else None,
+                                   self.bcs)
+        self.timings["assemble_s"] = time.perf_counter() - t0
+        self._factor_iteration_matrix(flexibility)
+        self._init_state(initial_velocity)
+        lame = forms.lame_fields(self.msh, cell_tags, materials)
+        self.outputs = ContactFields(V, self.comm, lambda w: forms.von_mises(w, lame, kind))
+        self.velocity = dolfinx.fem.Function(V, name="velocity")
+        self.u = self.outputs.u
+        self._last_out = None
+        self._to_functions()
+
+    # ---- set-up -----------------------------------------------------------------------
+    def _check_time_step(self, expected_contact_s: Optional[float]) -> None:
+        if expected_contact_s is not None:
+            if not (setup._finite(expected_contact_s) and expected_contact_s > 0):
+                raise ValueError(f"expected_contact_s={expected_contact_s!r}: must be a "
+                                 "finite number > 0 s")
+            t_c, how = float(expected_contact_s), "given as expected_contact_s"
+        else:
+            n = None
+            if self.comm.rank == 0:
+                n = np.abs(self.pairs.normal).mean(axis=0)
+                n = n / max(np.linalg.norm(n), 1e-300)
+            n = self.comm.bcast(n, root=0)
+            t_c = setup.expected_contact_duration(self.bodies, n)
+            how = "2L/c, the shortest wave round trip of the bodies along the contact normal"
+        self.expected_contact_s = t_c
+        setup.check_resolution(self.dt, t_c, how)
+
+    def _factor_iteration_matrix(self, flexibility: str) -> None:
+        t0 = time.perf_counter()
+        self.W_hat = setup.iteration_matrix(self.K, self.M, self.dt, self.theta, self.rayleigh,
+                                            self.marker)
+        e, dt, th = self.restitution, self.dt, self.theta
+
+        def kernel(dim, F, X, kpairs, mu, constrained, options):
+            return _cpp.ImpactContact(dim, F, X, kpairs, mu, e, dt, th, constrained, options)
+
+        self.condensation = Condensation(self.W_hat, self.bcs, self.pairs, self.mu, self.dim,
+                                         self.comm, self.options, flexibility, kernel=kernel)
+        c = self.condensation
+        self.factor, self.flex_info = c.factor, c.flex_info
+        self.contact, self.B, self.W_eff = c.contact, c.B, c.W
+        self.timings.update(c.timings)
+        self.timings["iteration_matrix_s"] = time.perf_counter() - t0
+
+    def _init_state(self, initial_velocity: Optional[dict]) -> None:
+        self.u_vec = self.K.createVecLeft()
+        self.u_vec.zeroEntries()
+        self.v_vec = self.K.createVecLeft()
+        setup.initial_velocity(self.v_vec, self.bodies, initial_velocity, self.marker,
+                               self.dim)
+        self._work = [self.K.createVecLeft() for _ in range(3)]
+        self.energy = EnergyAccount()
+        Mv = self._work[0]
+        self.M.mult(self.v_vec, Mv)
+        self.energy.start(0.5 * Mv.dot(self.v_vec), 0.0)
+        self.momentum0 = self._momentum(Mv)
+
+    def _momentum(self, Mv: PETSc.Vec) -> dict:
+        """Momentum of each body, Σ over its DOFs of (M v) per component [N·s]."""
+        arr = Mv.array_r
+        local = np.array([[arr[d].sum() for d in b.dofs] for b in self.bodies])
+        total = self.comm.allreduce(local, op=MPI.SUM)
+        return {b.name: total[i].tolist() for i, b in enumerate(self.bodies)}
+
+    # ---- one time step ---------------------------------------------------------------
+    def _solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        self.factor.solve(b, x)
+        self.back_substitutions += 1
+
+    def _free_velocity(self) -> PETSc.Vec:
+        """v_free = v⁻ + Ŵ⁻¹ h [f − C v⁻ − K (u⁻ + hθ v⁻)]."""
+        h, (alpha, beta) = self.dt, self.rayleigh
+        w, r, _ = self._work
+        self.u_vec.copy(w)
+        w.axpy(h * self.theta + beta, self.v_vec)
+        self.K.mult(w, r)
+        r.scale(-h)
+        if alpha:
+            self.M.mult(self.v_vec, w)
+            r.axpy(-h * alpha, w)
+        if self.f is not None:
+            r.axpy(h, self.f)
+        vfree = self.K.createVecLeft()
+        self._solve(r, vfree)
+        vfree.axpy(1.0, self.v_vec)
+        return vfree
+
+    def _contact(self, vfree: PETSc.Vec) -> Optional[dict]:
+        """The kernel's contact step on rank 0 (None elsewhere); errors on every rank."""
+        c = self.condensation
+        uc, vc, vfc = c.gather(self.u_vec), c.gather(self.v_vec), c.gather(vfree)
+        out, failure = None, None
+        if self.comm.rank == 0:
+            try:
+                out = self.contact.step(uc, vc, vfc)  # the step's one crossing
+            except ConvergenceError as e:
+                failure = (f"time step {len(self.records) + 1}: {e}",
+                           dict(getattr(e, "report", {})))
+            except ValueError as e:
+                failure = (f"time step {len(self.records) + 1}: {e}", None)
+        failure = self.comm.bcast(failure, root=0)
+        if failure:
+            if failure[1] is None:
+                raise ValueError(failure[0])
+            error = ConvergenceError(failure[0])
+            error.report = failure[1]
+            raise error
+        return out
+
+    def step(self) -> ImpactStepRecord:
+        """Advance one time step of size dt_s."""
+        t0 = time.perf_counter()
+        n_solves = self.back_substitutions
+        vfree = self._free_velocity()
+        out = self._contact(vfree)
+        root = self.comm.rank == 0
+        pushed = self.comm.bcast(bool(np.any(out["reaction"] != 0.0)) if root else None,
+                                 root=0)
+        v_new = vfree
+        if pushed:
+            r = self.condensation.reaction(out["reaction"] if root else None)
+            dv = self.K.createVecLeft()
+            self._solve(r, dv)
+            v_new.axpy(1.0, dv)
+            for o in (r, dv):
+                o.destroy()
+        du = self.K.createVecLeft()
+        du.axpy(self.dt * self.theta, v_new)
+        du.axpy(self.dt * (1.0 - self.theta), self.v_vec)
+        self._book_energy(du, v_new, out)
+        self.u_vec.axpy(1.0, du)
+        v_new.copy(self.v_vec)
+        for o in (du, v_new):
+            o.destroy()
+        self.t += self.dt
+        rec = self._record(out, self.back_substitutions - n_solves)
+        self.records.append(rec)
+        self._last_out = out
+        self._to_functions()
+        self.timings.setdefault("steps_s", []).append(time.perf_counter() - t0)
+        return rec
+
+    def _book_energy(self, du: PETSc.Vec, v_new: PETSc.Vec, out: Optional[dict]) -> None:
+        """The step's energies and works (energy.py) from its own definitions."""
+        Mv, Ku, w = self._work
+        alpha, beta = self.rayleigh
+        damping = 0.0
+        if alpha or beta:
+            w.set(0.0)
+            w.axpy(self.theta, v_new)
+            w.axpy(1.0 - self.theta, self.v_vec)
+            self.M.mult(w, Mv)
+            self.K.mult(w, Ku)
+            damping = self.dt * (alpha * w.dot(Mv) + beta * w.dot(Ku))
+        external = self.f.dot(du) if self.f is not None else 0.0
+        u_new = self.u_vec.copy()
+        u_new.axpy(1.0, du)
+        self.K.mult(u_new, Ku)
+        strain = 0.5 * u_new.dot(Ku)
+        u_new.destroy()
+        self.M.mult(v_new, Mv)
+        kinetic = 0.5 * v_new.dot(Mv)
+        works = (out["contact_work"], out["friction_work"]) if self.comm.rank == 0 else None
+        cw, fw = self.comm.bcast(works, root=0)
+        self.energy.add_step(kinetic, strain, external, damping, cw, fw)
+        self._last_momentum = self._momentum(Mv)
+
+    def _record(self, out: Optional[dict], solves: int) -> ImpactStepRecord:
+        rec = None
+        if self.comm.rank == 0:
+            s, rep = out["states"], out["report"]
+            closed = np.asarray(out["active"], bool)
+            rec = ImpactStepRecord(
+                step=len(self.records) + 1, t_s=self.t,
+                normal_force=float(out["normal_impulse"]) / self.dt,
+                slave_force=(np.asarray(out["slave_impulse"]) / self.dt).tolist(),
+                impulse=np.asarray(out["slave_impulse"]).tolist(),
+                active=int(closed.sum()), stick=int(((s == 1) & closed).sum()),
+                slip=int(((s == 2) & closed).sum()), open=int((s == 0).sum()),
+                back_substitutions=solves, solver=str(rep["solver"]),
+                iterations=int(rep["iterations"]),
+                max_penetration_m=float(out["max_penetration"]))
+        rec = self.comm.bcast(rec, root=0)
+        rec.energy = self.energy.history[-1]
+        rec.momentum = self._last_momentum
+        return rec
+
+    # ---- output -----------------------------------------------------------------------
+    def _to_functions(self) -> None:
+        """Displacement and velocity Functions from the state vectors."""
+        for vec, f in ((self.u_vec, self.outputs.u), (self.v_vec, self.velocity)):
+            n = vec.getLocalSize()
+            f.x.array[:n] = vec.array_r
+            f.x.scatter_forward()
+
+    def fields(self) -> list:
+        """Output Functions (collective): displacement, velocity, contact pressure (mean over
+        the last step, impulse / h / area), tangential traction, contact status (1 open,
+        2 stick, 3 slip), von Mises."""
+        from types import SimpleNamespace
+        d, out = self.dim, self._last_out
+        if self.comm.rank == 0 and out is not None:
+            inc = SimpleNamespace(lam=out["impulse"] / self.dt, states=out["states"],
+                                  tangential=out["pair_tangential"] / self.dt)
+        else:
+            m = self.m if self.comm.rank == 0 else 0
+            inc = SimpleNamespace(lam=np.zeros((m, d)), states=np.zeros(m, int),
+                                  tangential=np.zeros((m, d)))
+        self.outputs.write_back(inc, self.pairs)
+        f = self.outputs.all()
+        return [f[0], self.velocity] + f[1:]
+
+    def run(self, t_end_s: float, writer=None, write_every: int = 1,
+            progress: Optional[bool] = None) -> list[ImpactStepRecord]:
+        """Steps until t_end_s; ``writer`` (a ResultWriter) gets the fields every
+        ``write_every`` steps; a progress bar on rank 0 when ``progress`` (default: when
+        stderr is a terminal)."""
+        if not (setup._finite(t_end_s) and t_end_s > self.t):
+            raise ValueError(f"t_end_s={t_end_s!r}: must be finite and after t = {self.t:g} s")
+        n = int(round((t_end_s - self.t) / self.dt))
+        bar = None
+        if self.comm.rank == 0 and (progress or (progress is None and sys.stderr.isatty())):
+            from tqdm import tqdm
+            bar = tqdm(total=n, unit="step", desc="impact", file=sys.stderr)
+        if writer is not None and not self.records:
+            writer.write(self, 0.0)
+        try:
+            for i in range(n):
+                self.step()
+                if writer is not None and (i + 1) % write_every == 0:
+                    writer.write(self, self.t)
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+        return self.records

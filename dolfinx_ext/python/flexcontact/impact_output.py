@@ -1,0 +1,94 @@
+"""What an impact run reports: contact force history, its peak, duration and impulse, the
+energy account against time, as CSV, PNG and summary entries (rank 0 writes)."""
+from __future__ import annotations
+
+import csv
+import os
+from pathlib import Path
+from typing import Sequence, Union
+
+import numpy as np
+
+ENERGY_COLUMNS = ("kinetic", "strain", "external_work", "friction", "damping", "contact",
+                  "total", "balance_error")
+
+
+def contact_metrics(records: Sequence, dt_s: float, threshold: float = 1e-6) -> dict:
+    """Peak force, contact start, end and duration, impulse, mean force and episodes.
+
+    A step is in contact when its mean normal force exceeds ``threshold`` × the peak. The
+    duration runs from the start of the first such step to the end of the last one;
+    ``episodes`` counts separate runs of contact steps (1 for a clean impact).
+    """
+    F = np.array([r.normal_force for r in records])
+    peak = float(F.max(initial=0.0))
+    on = F > threshold * peak if peak > 0 else np.zeros(F.size, bool)
+    if not on.any():
+        return {"peak_force": 0.0, "contact_duration_s": 0.0, "impulse": 0.0,
+                "mean_force": 0.0, "contact_start_s": None, "contact_end_s": None,
+                "episodes": 0}
+    idx = np.flatnonzero(on)
+    t_end = np.array([r.t_s for r in records])
+    start, end = float(t_end[idx[0]] - dt_s), float(t_end[idx[-1]])
+    impulse = float(F.sum() * dt_s)
+    episodes = int(on[0]) + int(np.count_nonzero(np.diff(on.astype(int)) == 1))
+    return {"peak_force": peak, "contact_duration_s": end - start, "impulse": impulse,
+            "mean_force": impulse / (end - start), "contact_start_s": start,
+            "contact_end_s": end, "episodes": episodes}
+
+
+def write_history_csv(path: Union[str, os.PathLike], records: Sequence, energy0: float) -> None:
+    """One row per step: time, normal force, the slave force components, the energies."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    d = len(records[0].slave_force) if records else 0
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["t_s", "normal_force"] + [f"force_{c}" for c in "xyz"[:d]]
+                   + list(ENERGY_COLUMNS) + ["active_pairs", "back_substitutions"])
+        w.writerow([0.0, 0.0] + [0.0] * d + [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, energy0, 0.0]
+                   + [0, 0])
+        for r in records:
+            w.writerow([repr(r.t_s), repr(r.normal_force)] + [repr(x) for x in r.slave_force]
+                       + [repr(r.energy[k]) for k in ENERGY_COLUMNS]
+                       + [r.active, r.back_substitutions])
+
+
+def plot_history(path: Union[str, os.PathLike], records: Sequence, title: str,
+                 force_ref: float = None, duration_ref: float = None,
+                 start_s: float = 0.0, force_unit: str = "N", energy_unit: str = "J") -> None:
+    """Contact force and energies against time, one PNG with two panels (units as given:
+    per unit thickness in 2D)."""
+    from .output import pyplot
+    plt = pyplot()
+    t = np.array([r.t_s for r in records]) * 1e3
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
+    a1.step(t, [r.normal_force for r in records], where="pre", label="contact force")
+    if force_ref is not None and duration_ref is not None:
+        a1.plot(np.array([start_s, start_s, start_s + duration_ref, start_s + duration_ref])
+                * 1e3, [0, force_ref, force_ref, 0], "k--", lw=0.8, label="1D theory")
+    a1.set_xlabel("t [ms]")
+    a1.set_ylabel(f"contact force [{force_unit}]")
+    a1.set_title(title)
+    a1.legend()
+    a1.grid(alpha=0.3)
+    for key, style in (("kinetic", "-"), ("strain", "-"), ("contact", "--"),
+                       ("friction", "--"), ("damping", "--"), ("total", "k-")):
+        a2.plot(t, [r.energy[key] for r in records], style, label=key)
+    a2.set_xlabel("t [ms]")
+    a2.set_ylabel(f"energy [{energy_unit}]")
+    a2.legend(fontsize=8)
+    a2.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def cost_summary(records: Sequence) -> dict:
+    """Back-substitutions per step: mean, and medians of steps with and without contact."""
+    b = np.array([r.back_substitutions for r in records])
+    on = np.array([r.active > 0 for r in records])
+    med = lambda x: float(np.median(x)) if x.size else None  # noqa: E731
+    return {"back_substitutions_per_step": float(b.mean()) if b.size else 0.0,
+            "median_with_contact": med(b[on]), "median_without_contact": med(b[~on]),
+            "steps": int(b.size), "steps_with_contact": int(on.sum())}

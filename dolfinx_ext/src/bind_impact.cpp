@@ -1,0 +1,154 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file bind_impact.cpp
+/// @brief Python binding of the Moreau–Jean contact step (kernel/.../impact.hpp).
+///
+/// A time step crosses the binding once: step() takes the contact-DOF values of u⁻, v⁻ and
+/// v_free and hands back a plain dict of NumPy arrays and numbers.
+
+#include "bindings.h"
+
+#include <flexcontact/impact.hpp>
+#include <flexcontact/increment.hpp>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <optional>
+
+namespace py = pybind11;
+using namespace flexcontact;
+
+namespace
+{
+using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
+
+py::array_t<double> rows(const Vector& v, Eigen::Index cols)
+{
+  const Eigen::Index m = cols ? v.size() / cols : 0;
+  py::array_t<double> a({static_cast<py::ssize_t>(m), static_cast<py::ssize_t>(cols)});
+  if (v.size())
+    std::memcpy(a.mutable_data(), v.data(), sizeof(double) * v.size());
+  return a;
+}
+
+py::dict report(const SolveReport& r)
+{
+  py::dict d;
+  d["solver"] = r.solver;
+  d["converged"] = r.converged;
+  d["iterations"] = r.iterations;
+  d["state_changes"] = r.state_changes;
+  d["residual"] = r.residual;
+  d["cycled"] = r.cycled;
+  d["attempts"] = r.attempts;
+  return d;
+}
+
+py::dict step_dict(const ImpactStep& r, int dim)
+{
+  py::dict d;
+  d["impulse"] = rows(r.impulse, dim);
+  d["velocity"] = rows(r.velocity, dim);
+  d["velocity_before"] = rows(r.velocity_before, dim);
+  d["gap"] = rows(r.gap, dim);
+  py::array_t<int> states(static_cast<py::ssize_t>(r.states.size()));
+  py::array_t<bool> active(static_cast<py::ssize_t>(r.active.size()));
+  for (std::size_t i = 0; i < r.states.size(); ++i)
+  {
+    states.mutable_at(i) = static_cast<int>(r.states[i]);
+    active.mutable_at(i) = r.active[i];
+  }
+  d["states"] = states;
+  d["active"] = active;
+  d["reaction"] = py::array_t<double>(r.reaction.size(), r.reaction.data());
+  d["normal_impulse"] = r.normal_impulse;
+  d["slave_impulse"] = py::array_t<double>(r.slave_impulse.size(), r.slave_impulse.data());
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> t
+      = r.pair_tangential;
+  d["pair_tangential"] = py::array_t<double>({t.rows(), t.cols()}, t.data());
+  d["friction_work"] = r.friction_work;
+  d["contact_work"] = r.contact_work;
+  d["max_penetration"] = r.max_penetration;
+  d["active_pairs"] = r.active_pairs;
+  d["report"] = report(r.report);
+  return d;
+}
+} // namespace
+
+void flexcontact::bind_impact(py::module& m)
+{
+  const py::handle convergence_error = m.attr("ConvergenceError");
+  py::class_<ImpactContact>(
+      m, "ImpactContact",
+      "The contact part of a Moreau-Jean time step: B, x0, W_eff = B Fhat B^T with "
+      "Fhat = (What^-1)_cc, What = M + h theta C + h^2 theta^2 K; restitution e.")
+      .def(py::init(
+               [](int dim, Matrix F, Matrix X, std::vector<ContactPair> pairs, Vector mu,
+                  double e, double dt, double theta, const std::optional<BoolArray>& held,
+                  const SolverOptions& options)
+               {
+                 std::vector<bool> flags;
+                 if (held)
+                   flags.assign(held->data(), held->data() + held->size());
+                 return ImpactContact(dim, std::move(F), std::move(X), std::move(pairs),
+                                      std::move(mu), e, dt, theta, std::move(flags), options);
+               }),
+           py::arg("dim"), py::arg("F"), py::arg("X"), py::arg("pairs"), py::arg("mu"),
+           py::arg("restitution"), py::arg("dt_s"), py::arg("theta") = 0.5,
+           py::arg("constrained") = py::none(), py::arg("options") = SolverOptions())
+      .def(
+          "step",
+          [convergence_error](ImpactContact& c, const Vector& u_c, const Vector& v_c,
+                              const Vector& vfree_c)
+          {
+            ImpactStep r;
+            try
+            {
+              py::gil_scoped_release release;
+              r = c.step(u_c, v_c, vfree_c);
+            }
+            catch (const ConvergenceError& e)
+            {
+              py::object error = convergence_error(e.what());
+              error.attr("report") = report(e.report);
+              PyErr_SetObject(convergence_error.ptr(), error.ptr());
+              throw py::error_already_set();
+            }
+            return step_dict(r, c.dim());
+          },
+          py::arg("u_c"), py::arg("v_c"), py::arg("vfree_c"),
+          "Contact impulses of one step from the contact-DOF values of u-, v- and the free "
+          "velocity. Returns a dict: impulse, velocity (U+), velocity_before (U-), gap (m x d, "
+          "local frames), states, active, reaction (n_c, B^T P), normal_impulse, "
+          "slave_impulse (d, global), pair_tangential, friction_work, contact_work, "
+          "max_penetration, active_pairs, report")
+      .def("set_flexibility", &ImpactContact::set_flexibility, py::arg("F"), py::arg("dt_s"))
+      .def_property_readonly("B", [](const ImpactContact& c)
+                             { return Eigen::SparseMatrix<double, Eigen::RowMajor>(c.B()); })
+      .def_property_readonly("x0", [](const ImpactContact& c) { return c.x0(); })
+      .def_property_readonly("W", [](const ImpactContact& c) { return c.W(); })
+      .def_property_readonly("F", [](const ImpactContact& c) { return c.flexibility(); })
+      .def_property_readonly("mu", [](const ImpactContact& c) { return c.mu(); })
+      .def_property_readonly(
+          "frames",
+          [](const ImpactContact& c)
+          {
+            const int d = c.dim();
+            py::array_t<double> a({c.pairs(), d, d});
+            auto v = a.mutable_unchecked<3>();
+            for (int k = 0; k < c.pairs(); ++k)
+              for (int i = 0; i < d; ++i)
+                for (int j = 0; j < d; ++j)
+                  v(k, i, j) = c.contact_pairs()[k].frame(i, j);
+            return a;
+          })
+      .def_property_readonly("restitution", &ImpactContact::restitution)
+      .def_property_readonly("dt_s", &ImpactContact::dt)
+      .def_property_readonly("theta", &ImpactContact::theta)
+      .def("pairs", &ImpactContact::pairs)
+      .def("contact_dofs", &ImpactContact::contact_dofs)
+      .def("dim", &ImpactContact::dim);
+}

@@ -1,0 +1,120 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file impact.hpp
+/// @brief One time step of dynamic contact on the condensed system: the Moreau–Jean
+/// θ-scheme at velocity level with Newton restitution and Coulomb friction on impulses
+/// (docs/impact.md).
+///
+/// The iteration matrix Ŵ = M + hθC + h²θ²K is factored once per time-step size outside the
+/// kernel; F̂ = (Ŵ⁻¹)_cc, its inverse on the contact DOFs, comes in. With U = B v the relative
+/// velocity of the pairs in their local frames (normal first), the step's local problem is
+///
+///     U⁺ = W_eff P + U_free,   W_eff = B F̂ Bᵀ,
+///     for pairs of the index set I:  x_n = U_n⁺ + e U_n⁻ ≥ 0 ⟂ P_n ≥ 0,
+///                                    Coulomb on (P_t, U_t⁺) as in problem.hpp,
+///     for the others:                P = 0,
+///
+/// which is the kernel's local problem x = W λ + q with q = U_free + e U_n⁻ (normal rows):
+/// the same local solvers serve. I holds the pairs whose predicted gap g⁻ + hθ U_n⁻ is ≤ 0.
+/// Contact DOFs are node-major as in pairs.hpp.
+
+#include "flexcontact/pairs.hpp"
+#include "flexcontact/problem.hpp"
+
+#include <Eigen/Sparse>
+#include <vector>
+
+namespace flexcontact
+{
+/// @brief What one time step's contact solve produced. Pair-by-pair vectors are normal
+/// first, in the local frames; P is an impulse (N·s; N·s/m per unit thickness in 2D).
+struct ImpactStep
+{
+  Vector impulse;                 ///< m·d, P
+  Vector velocity;                ///< m·d, U⁺ = W_eff P + U_free
+  Vector velocity_before;         ///< m·d, U⁻ = B v⁻
+  Vector gap;                     ///< m·d, gap at the start of the step, B u⁻ + x0
+  std::vector<PairState> states;  ///< per pair; open for pairs outside the index set
+  std::vector<bool> active;       ///< per pair: in the index set I
+  SolveReport report;             ///< the local solve (solver "none" when I is empty)
+  Vector reaction;                ///< n_c, r_c = Bᵀ P; zero on constrained contact DOFs
+  double normal_impulse = 0.0;    ///< Σ_k P_n,k
+  Vector slave_impulse;           ///< d, Σ_k T_kᵀ P_k: impulse on the slave side, global axes
+  Matrix pair_tangential;         ///< m × d, T_kᵀ (0, P_t,k) per pair, global axes
+  /// Σ_k P_t,k·U_t,k⁺ ≤ 0: the work of friction (its dissipation is minus this)
+  double friction_work = 0.0;
+  /// Σ_k P_k·(U_k⁺ + U_k⁻)/2: the work of all contact impulses in the θ = ½ energy balance
+  double contact_work = 0.0;
+  double max_penetration = 0.0;   ///< max(0, −min_k g_n,k) at the start of the step
+  int active_pairs = 0;           ///< |I|
+};
+
+/// @brief The contact part of a Moreau–Jean time step on the condensed system.
+///
+/// Holds B, x0 and W_eff = B F̂ Bᵀ for one time-step size, the restitution coefficient and
+/// the last impulses (warm start). Stateless otherwise: the step gets the contact-DOF values
+/// of u⁻, v⁻ and the free velocity v_free = v⁻ + Ŵ⁻¹ h r, so that one step crosses the
+/// binding once. A contact DOF held by a Dirichlet condition gets no flexibility (rows and
+/// columns of F̂ zeroed): a body whose nodes are all held is exactly rigid.
+class ImpactContact
+{
+public:
+  /// @param dim 2 or 3
+  /// @param Fhat n_c × n_c, (Ŵ⁻¹)_cc on the contact DOFs
+  /// @param X n_nodes × dim coordinates of the contact nodes
+  /// @param pairs slave, masters, weights and frame of each pair
+  /// @param mu friction coefficient per pair
+  /// @param restitution Newton's e in [0, 1]
+  /// @param dt_s time step h > 0
+  /// @param theta θ in [½, 1]
+  /// @param constrained n_c flags of Dirichlet-held contact DOFs, or empty for none
+  /// @throws std::invalid_argument naming the argument whose size or value is wrong
+  ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<ContactPair> pairs, Vector mu,
+                double restitution, double dt_s, double theta,
+                std::vector<bool> constrained = {}, SolverOptions options = {});
+
+  /// @brief Contact impulses of one step from the contact-DOF values of u⁻, v⁻ and v_free.
+  /// @throws std::invalid_argument on wrong sizes or non-finite values
+  /// @throws ConvergenceError if no local solver converges (the warm start is kept)
+  ImpactStep step(const Eigen::Ref<const Vector>& u_c, const Eigen::Ref<const Vector>& v_c,
+                  const Eigen::Ref<const Vector>& vfree_c);
+
+  /// @brief New time-step size: F̂ of the new Ŵ, W_eff rebuilt; pairs kept.
+  /// @throws std::invalid_argument on a wrong size, non-finite entries or dt_s ≤ 0
+  void set_flexibility(Matrix Fhat, double dt_s);
+
+  const Eigen::SparseMatrix<double>& B() const { return B_; } ///< m·d × n_c
+  const Vector& x0() const { return x0_; }                   ///< initial gap, m·d
+  const Matrix& W() const { return W_; }                     ///< W_eff, m·d × m·d
+  const Matrix& flexibility() const { return F_; }           ///< F̂, constrained zeroed
+  const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
+  const Vector& mu() const { return mu_; }
+  double restitution() const { return e_; }
+  double dt() const { return dt_; }
+  double theta() const { return theta_; }
+  int dim() const { return dim_; }
+  int pairs() const { return static_cast<int>(pairs_.size()); }
+  int contact_dofs() const { return static_cast<int>(F_.rows()); }
+
+private:
+  /// @brief Impulses of the pairs in I from the local problem x = W_II P + q_I.
+  void solve_active(ImpactStep& r, const Vector& Ufree);
+  /// @brief Reaction, totals and the energy terms of a solved step.
+  void finish(ImpactStep& r) const;
+
+  int dim_;
+  Matrix F_;
+  Matrix X_;
+  std::vector<ContactPair> pairs_;
+  Vector mu_;
+  double e_, dt_, theta_;
+  std::vector<bool> constrained_;
+  SolverOptions options_;
+  Eigen::SparseMatrix<double> B_;
+  Vector x0_;
+  Matrix W_;
+  Vector last_P_;                  ///< warm start
+  std::vector<PairState> last_states_;
+};
+} // namespace flexcontact

@@ -1,0 +1,227 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file impact.cpp
+/// @brief The contact part of a Moreau–Jean time step: index set from the predicted gap,
+/// the velocity-level local problem on it (restitution folded into q), impulses back to the
+/// contact DOFs, and the contact terms of the energy balance.
+
+#include "flexcontact/impact.hpp"
+#include "flexcontact/increment.hpp"
+#include "flexcontact/solvers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace flexcontact
+{
+namespace
+{
+const std::string who = "flexcontact: ImpactContact: ";
+
+std::string num(double v)
+{
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+void check_flexibility(const Matrix& F, Eigen::Index n_c)
+{
+  if (F.rows() != n_c || F.cols() != n_c)
+    throw std::invalid_argument(who + "Fhat is " + std::to_string(F.rows()) + "x"
+                                + std::to_string(F.cols()) + ", expected "
+                                + std::to_string(n_c) + "x" + std::to_string(n_c)
+                                + " (contact nodes × dim)");
+  if (!F.allFinite())
+    throw std::invalid_argument(who + "Fhat is not finite");
+}
+
+void check_dt(double dt)
+{
+  if (!std::isfinite(dt) || !(dt > 0.0))
+    throw std::invalid_argument(who + "dt_s is " + num(dt) + "; it must be finite and > 0");
+}
+
+void check_vector(const char* name, const Eigen::Ref<const Vector>& v, Eigen::Index n)
+{
+  if (v.size() != n)
+    throw std::invalid_argument(who + "step: " + name + " has " + std::to_string(v.size())
+                                + " entries, expected n_c = " + std::to_string(n));
+  if (!v.allFinite())
+    throw std::invalid_argument(who + "step: " + name + " is not finite");
+}
+
+void zero_constrained(Matrix& F, const std::vector<bool>& constrained)
+{
+  for (std::size_t i = 0; i < constrained.size(); ++i)
+    if (constrained[i])
+    {
+      F.row(static_cast<Eigen::Index>(i)).setZero();
+      F.col(static_cast<Eigen::Index>(i)).setZero();
+    }
+}
+} // namespace
+
+ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<ContactPair> pairs,
+                             Vector mu, double restitution, double dt_s, double theta,
+                             std::vector<bool> constrained, SolverOptions options)
+    : dim_(dim), F_(std::move(Fhat)), X_(std::move(X)), pairs_(std::move(pairs)),
+      mu_(std::move(mu)), e_(restitution), dt_(dt_s), theta_(theta),
+      constrained_(std::move(constrained)), options_(std::move(options))
+{
+  if (dim_ != 2 && dim_ != 3)
+    throw std::invalid_argument(who + "dim is " + std::to_string(dim_) + "; it must be 2 or 3");
+  if (X_.cols() != dim_ || !X_.allFinite())
+    throw std::invalid_argument(who + "X must be finite with dim = " + std::to_string(dim_)
+                                + " columns");
+  if (!(e_ >= 0.0 && e_ <= 1.0))
+    throw std::invalid_argument(who + "restitution is " + num(e_)
+                                + "; it must lie in [0, 1]");
+  check_dt(dt_);
+  if (!(theta_ >= 0.5 && theta_ <= 1.0))
+    throw std::invalid_argument(who + "theta is " + num(theta_) + "; it must lie in [0.5, 1]");
+  const Eigen::Index n_c = X_.rows() * dim_;
+  check_flexibility(F_, n_c);
+  if (!constrained_.empty() && static_cast<Eigen::Index>(constrained_.size()) != n_c)
+    throw std::invalid_argument(who + "constrained has " + std::to_string(constrained_.size())
+                                + " entries, expected 0 or n_c = " + std::to_string(n_c));
+  if (static_cast<std::size_t>(mu_.size()) != pairs_.size())
+    throw std::invalid_argument(who + "mu has " + std::to_string(mu_.size())
+                                + " entries but there are " + std::to_string(pairs_.size())
+                                + " pairs");
+  for (Eigen::Index k = 0; k < mu_.size(); ++k)
+    if (!std::isfinite(mu_[k]) || mu_[k] < 0.0)
+      throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
+                                  + " is " + num(mu_[k]) + "; it must be finite and >= 0");
+  zero_constrained(F_, constrained_);
+  B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
+  x0_ = initial_gap(pairs_, X_);
+  W_ = delassus(B_, F_);
+  last_P_ = Vector::Zero(static_cast<Eigen::Index>(pairs_.size()) * dim_);
+  last_states_.assign(pairs_.size(), PairState::open);
+}
+
+void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
+{
+  check_dt(dt_s);
+  check_flexibility(Fhat, F_.rows());
+  zero_constrained(Fhat, constrained_);
+  W_ = delassus(B_, Fhat);
+  F_ = std::move(Fhat);
+  dt_ = dt_s;
+}
+
+ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
+                               const Eigen::Ref<const Vector>& v_c,
+                               const Eigen::Ref<const Vector>& vfree_c)
+{
+  check_vector("u_c", u_c, F_.rows());
+  check_vector("v_c", v_c, F_.rows());
+  check_vector("vfree_c", vfree_c, F_.rows());
+  const int m = pairs(), d = dim_;
+  ImpactStep r;
+  r.gap = B_ * u_c + x0_;
+  r.velocity_before = B_ * v_c;
+  const Vector Ufree = B_ * vfree_c;
+  r.active.assign(m, false);
+  for (int k = 0; k < m; ++k)
+  {
+    // Predicted gap at θ of the step: pairs that may close within it take part.
+    const double predicted = r.gap[k * d] + dt_ * theta_ * r.velocity_before[k * d];
+    r.active[k] = predicted <= 0.0;
+    r.active_pairs += r.active[k] ? 1 : 0;
+  }
+  r.impulse = Vector::Zero(m * d);
+  r.states.assign(m, PairState::open);
+  if (r.active_pairs > 0)
+    solve_active(r, Ufree);
+  else
+  {
+    r.report.solver = "none";
+    r.report.converged = true;
+    r.report.residual = 0.0;
+  }
+  r.velocity = W_ * r.impulse + Ufree;
+  finish(r);
+  last_P_ = r.impulse;
+  last_states_ = r.states;
+  return r;
+}
+
+void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
+{
+  const int m = pairs(), d = dim_;
+  std::vector<int> idx; // unknowns of the active pairs
+  std::vector<int> act;
+  for (int k = 0; k < m; ++k)
+    if (r.active[k])
+    {
+      act.push_back(k);
+      for (int j = 0; j < d; ++j)
+        idx.push_back(k * d + j);
+    }
+  const Eigen::Index n = static_cast<Eigen::Index>(idx.size());
+  Matrix W(n, n);
+  Vector q(n), mu(act.size()), P0(n);
+  std::vector<PairState> s0(act.size());
+  for (Eigen::Index a = 0; a < n; ++a)
+  {
+    for (Eigen::Index b = 0; b < n; ++b)
+      W(a, b) = W_(idx[a], idx[b]);
+    q[a] = Ufree[idx[a]];
+    P0[a] = last_P_[idx[a]];
+  }
+  for (std::size_t a = 0; a < act.size(); ++a)
+  {
+    // Newton's law U_n⁺ ≥ −e U_n⁻ becomes x_n = U_n⁺ + e U_n⁻ ≥ 0, a shift of q only.
+    q[a * d] += e_ * r.velocity_before[act[a] * d];
+    mu[a] = mu_[act[a]];
+    s0[a] = last_states_[act[a]] == PairState::open ? PairState::stick : last_states_[act[a]];
+  }
+  const ProblemView view{d, W, q, mu};
+  SolveReport rep = solve(view, P0, s0, options_);
+  if (!rep.converged)
+  {
+    std::string what = who + "time step contact did not converge; best residual "
+                       + num(rep.residual) + " (tolerance " + num(options_.tolerance)
+                       + ") from " + rep.solver + ". Tried:";
+    for (const auto& a : rep.attempts)
+      what += " [" + a + "]";
+    throw ConvergenceError(what, std::move(rep));
+  }
+  for (Eigen::Index a = 0; a < n; ++a)
+    r.impulse[idx[a]] = rep.lambda[a];
+  for (std::size_t a = 0; a < act.size(); ++a)
+    r.states[act[a]] = rep.states[a];
+  r.report = std::move(rep);
+}
+
+void ImpactContact::finish(ImpactStep& r) const
+{
+  const int m = pairs(), d = dim_;
+  r.slave_impulse = Vector::Zero(d);
+  r.pair_tangential = Matrix::Zero(m, d);
+  double min_gap = 0.0;
+  for (int k = 0; k < m; ++k)
+  {
+    const Matrix& T = pairs_[k].frame;
+    r.normal_impulse += r.impulse[k * d];
+    r.slave_impulse += T.transpose() * r.impulse.segment(k * d, d);
+    min_gap = std::min(min_gap, r.gap[k * d]);
+    for (int j = 1; j < d; ++j)
+    {
+      r.pair_tangential.row(k) += r.impulse[k * d + j] * T.row(j);
+      r.friction_work += r.impulse[k * d + j] * r.velocity[k * d + j];
+    }
+  }
+  r.contact_work = 0.5 * r.impulse.dot(r.velocity + r.velocity_before);
+  r.max_penetration = std::max(0.0, -min_gap);
+  r.reaction = B_.transpose() * r.impulse;
+  for (std::size_t i = 0; i < constrained_.size(); ++i)
+    if (constrained_[i])
+      r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+}
+} // namespace flexcontact

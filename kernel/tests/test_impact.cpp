@@ -1,0 +1,168 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file test_impact.cpp
+/// @brief The Moreau–Jean contact step on small systems integrated here with dense algebra:
+/// a mass–spring hitting a rigid wall (impulse, contact duration, energy), restitution of a
+/// single mass, Coulomb friction on impulses, and bad input.
+
+#include "contact_testing.hpp"
+#include "flexcontact/impact.hpp"
+#include "flexcontact/increment.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+using namespace flexcontact;
+using namespace flexcontact::testing;
+
+namespace
+{
+// Three nodes in 2D: node 0 (front mass, slave) touches the wall at x = 0, node 1 (back
+// mass) sits at x = L behind it, joined by a spring k along x; node 2 is the wall (master,
+// held). Global DOF 2i + c; the contact nodes are node 0 (contact node 0) and node 2
+// (contact node 1), so the contact DOFs are 0, 1, 4, 5.
+constexpr double m = 2.0, k = 800.0, L = 1.0;
+const std::vector<int> contact_dofs{0, 1, 4, 5};
+const std::vector<bool> wall_held{false, false, true, true};
+
+struct ImpactRun
+{
+  Vector u, v;                   ///< final state
+  double impulse_x = 0.0;        ///< Σ of the slave impulses along x (on the masses)
+  double contact_work = 0.0, friction_work = 0.0;
+  int first_contact = -1, last_contact = -1;
+  double energy0 = 0.0, energy = 0.0;
+};
+
+double energy(const Matrix& M, const Matrix& K, const Vector& u, const Vector& v)
+{
+  return 0.5 * v.dot(M * v) + 0.5 * u.dot(K * u);
+}
+
+/// @brief Integrates the θ = ½ scheme for `steps` steps of size h from v0 on both masses
+/// (spring on: the mass–spring; spring off and back mass far: a single mass).
+ImpactRun integrate(double h, int steps, const Vector& v0, double e, double mu, double kk = k)
+{
+  const double theta = 0.5;
+  Matrix M = Matrix::Zero(6, 6), K = Matrix::Zero(6, 6);
+  M.diagonal() << m, m, m, m, 0, 0;
+  K(0, 0) = K(2, 2) = kk;
+  K(0, 2) = K(2, 0) = -kk;
+  Matrix What = M + h * h * theta * theta * K;
+  What(4, 4) = What(5, 5) = 1.0; // held DOFs: identity rows, as DOLFINx assembles them
+  const Eigen::LLT<Matrix> factor(What);
+  const Matrix Winv = factor.solve(Matrix::Identity(6, 6));
+  Matrix F(4, 4);
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      F(a, b) = Winv(contact_dofs[a], contact_dofs[b]);
+  const Matrix X = (Matrix(2, 2) << 0.0, 0.0, 0.0, 0.0).finished();
+  ImpactContact c(2, F, X, {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))}, vec({mu}), e, h, theta,
+                  wall_held);
+
+  ImpactRun r;
+  Vector u = Vector::Zero(6), v = Vector::Zero(6);
+  u[2] = 0.0; // the back node's displacement; its position is L
+  v.head(4) << v0[0], v0[1], v0[0], v0[1];
+  r.energy0 = energy(M, K, u, v);
+  auto gather = [](const Vector& g)
+  {
+    Vector x(4);
+    for (int a = 0; a < 4; ++a)
+      x[a] = g[contact_dofs[a]];
+    return x;
+  };
+  for (int i = 0; i < steps; ++i)
+  {
+    const Vector res = -h * (K * (u + h * theta * v));
+    const Vector vfree = v + factor.solve(res);
+    const ImpactStep s = c.step(gather(u), gather(v), gather(vfree));
+    Vector rg = Vector::Zero(6);
+    for (int a = 0; a < 4; ++a)
+      rg[contact_dofs[a]] = s.reaction[a];
+    const Vector vnew = vfree + factor.solve(rg);
+    u += h * (theta * vnew + (1 - theta) * v);
+    v = vnew;
+    r.impulse_x += s.slave_impulse[0];
+    r.contact_work += s.contact_work;
+    r.friction_work += s.friction_work;
+    if (s.impulse[0] > 0.0)
+    {
+      r.first_contact = r.first_contact < 0 ? i : r.first_contact;
+      r.last_contact = i;
+    }
+  }
+  r.u = u;
+  r.v = v;
+  r.energy = energy(M, K, u, v);
+  return r;
+}
+} // namespace
+
+TEST(Impact, MassSpringOnAWallLosesTheFrontMassEnergyAndBouncesOff)
+{
+  // e = 0: the front mass stops at once (impulse m v), the spring stops the back mass over
+  // half a period π/ω of the back mass on a fixed spring (impulse 2 m v), and the pair
+  // leaves with the back mass at v: 3 m v in all, and ½ m v² of the m v² is lost.
+  const double v = 1.5, omega = std::sqrt(k / m), tc = std::numbers::pi / omega;
+  const double h = tc / 400;
+  const ImpactRun r = integrate(h, 600, vec({-v, 0.0}), 0.0, 0.0);
+  EXPECT_NEAR(r.impulse_x, 3 * m * v, 1e-3 * m * v);
+  // Impulse = change of momentum, exactly for the scheme (K's rows sum to zero).
+  EXPECT_NEAR(r.impulse_x, m * (r.v[0] + r.v[2]) - m * (-2 * v), 1e-10 * m * v);
+  EXPECT_NEAR((r.last_contact + 1 - r.first_contact) * h, tc, 0.01 * tc);
+  EXPECT_NEAR(r.energy, 0.5 * m * v * v, 0.01 * 0.5 * m * v * v);
+  // Energy balance of the θ = ½ scheme: E − E0 = Σ P·(U⁺ + U⁻)/2, to round-off.
+  EXPECT_NEAR(r.energy - r.energy0, r.contact_work, 1e-10 * r.energy0);
+}
+
+TEST(Impact, RestitutionSetsTheReboundOfASingleMass)
+{
+  // No spring: the front mass alone. U_n⁺ = −e U_n⁻, and with e = 1 no energy is lost.
+  for (double e : {0.0, 0.5, 1.0})
+  {
+    const ImpactRun r = integrate(1e-3, 20, vec({-2.0, 0.0}), e, 0.0, 0.0);
+    EXPECT_NEAR(r.v[0], 2.0 * e, 1e-12) << "e = " << e;
+    EXPECT_NEAR(r.impulse_x, m * 2.0 * (1 + e), 1e-12) << "e = " << e;
+    EXPECT_NEAR(r.energy - r.energy0, r.contact_work, 1e-12 * r.energy0) << "e = " << e;
+  }
+}
+
+TEST(Impact, FrictionImpulseIsMuTimesNormalWhileSliding)
+{
+  // A single mass hits the wall obliquely, fast along the wall: it slides throughout, so
+  // P_t = μ P_n and the tangential speed drops by μ (1 + e) v_n. Friction dissipates.
+  const double vn = 1.0, vt = 3.0, mu = 0.3, e = 0.5;
+  const ImpactRun r = integrate(1e-3, 20, vec({-vn, vt}), e, mu, 0.0);
+  EXPECT_NEAR(r.v[0], e * vn, 1e-12);
+  EXPECT_NEAR(r.v[1], vt - mu * (1 + e) * vn, 1e-9);
+  EXPECT_NEAR(r.impulse_x, m * vn * (1 + e), 1e-12);
+  EXPECT_LT(r.friction_work, 0.0);
+  EXPECT_NEAR(r.energy - r.energy0, r.contact_work, 1e-12 * r.energy0);
+  // Slow along the wall: it sticks, and the tangential velocity stops.
+  const ImpactRun s = integrate(1e-3, 20, vec({-vn, 0.1}), e, mu, 0.0);
+  EXPECT_NEAR(s.v[1], 0.0, 1e-9);
+}
+
+TEST(Impact, BadInputIsNamed)
+{
+  const Matrix F = Matrix::Identity(4, 4);
+  const Matrix X = Matrix::Zero(2, 2);
+  auto make = [&](double e, double h, double theta)
+  {
+    ImpactContact c(2, F, X, {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))}, vec({0.0}), e, h,
+                    theta);
+  };
+  EXPECT_NE(message_of([&] { make(1.5, 1e-3, 0.5); }).find("restitution is 1.5"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] { make(0.0, 0.0, 0.5); }).find("dt_s is 0"), std::string::npos);
+  EXPECT_NE(message_of([&] { make(0.0, NAN, 0.5); }).find("dt_s is nan"), std::string::npos);
+  EXPECT_NE(message_of([&] { make(0.0, 1e-3, 0.3); }).find("theta is 0.3"), std::string::npos);
+  ImpactContact c(2, F, X, {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))}, vec({0.0}), 0.0, 1e-3,
+                  0.5);
+  const Vector z = Vector::Zero(4);
+  EXPECT_NE(message_of([&] { c.step(z, Vector::Zero(3), z); }).find("v_c has 3 entries"),
+            std::string::npos);
+}
