@@ -16,12 +16,15 @@ from ._cpp import (ConvergenceError, MumpsError, PetscError, SingularStiffnessEr
 from .boundary import dirichlet
 from .names import FLEXIBILITY_METHODS, SOLVER_NAMES, FlexibilityMethod, SolverName
 from .output import ResultWriter, results_folder, write_summary
-from .problem import ContactInterface, ContactProblem, IncrementSummary
+from .problem import (ContactInterface, ContactProblem, ContactZoneError, ContactZoneWarning,
+                      IncrementSummary)
+from .rigid import RigidTarget
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ContactInterface", "ContactProblem", "IncrementSummary", "SolverOptions",
+    "RigidTarget", "ContactZoneWarning", "ContactZoneError",
     "dirichlet", "ResultWriter", "results_folder", "write_summary",
     "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",

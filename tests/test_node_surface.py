@@ -1,0 +1,200 @@
+"""Node–surface pairing, rigid targets and the candidate-zone guard on real meshes.
+
+References: Hertz's line and point contact (flexcontact.analytic, recomputed here from the
+loads the demos reached), the node–node answer on matching meshes (the same pairs), and
+the count of factorizations (one, however often the pairs are re-made).
+"""
+import warnings
+
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+
+import flexcontact as fc
+from demo_runner import A_TARGET, R_HERTZ, STEEL, assert_inputs, run_demo
+from flexcontact import analytic, compat, forms
+from flexcontact.meshes import hertz2d, tags
+
+ESTAR_STEEL = analytic.effective_modulus(STEEL["E_Pa"], STEEL["nu"], STEEL["E_Pa"], STEEL["nu"])
+ESTAR_RIGID = STEEL["E_Pa"] / (1 - STEEL["nu"] ** 2)
+STEEL_M = forms.Material(E_Pa=STEEL["E_Pa"], nu=STEEL["nu"], name="steel")
+NONMATCHING_REFINE = 2   # finest test mesh of the non-matching Hertz demo
+RIGID_REFINE = 1
+
+
+def _hertz2d_problem(msh, cells, facets, **interface):
+    V = compat.vector_space(msh)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
+    a = forms.elasticity_form(u, v, {tags.BASE: STEEL_M, tags.UPPER: STEEL_M}, dx,
+                              "plane_strain")
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    top, (_, top_y) = fc.dirichlet(V, facets, tags.LOADED)
+    problem = fc.ContactProblem(a, None, fixed + top,
+                                fc.ContactInterface(facets, mu=0.0, **interface))
+    return problem, top_y
+
+
+@pytest.fixture(scope="module")
+def matching():
+    return hertz2d.build(MPI.COMM_WORLD, R=R_HERTZ, a_expected=A_TARGET)
+
+
+def test_node_surface_equals_node_node_on_matching_meshes(matching):
+    # Each cylinder node lies above a block node: its closest point on the flat block is
+    # that node (weights 1, 0), so the first increment's pairs, W and λ are node–node's.
+    msh, cells, facets, geo = matching
+    lam = {}
+    for pairing in ("node_to_node", "node_to_surface"):
+        problem, top_y = _hertz2d_problem(msh, cells, facets, slave=tags.SLAVE,
+                                          master=tags.MASTER, pairing=pairing)
+        top_y.value = -A_TARGET**2 / R_HERTZ
+        inc = problem.step()
+        lam[pairing] = inc.lam
+        assert problem.factorizations == 1
+    if MPI.COMM_WORLD.rank == 0:
+        ref = lam["node_to_node"]
+        assert np.max(np.abs(lam["node_to_surface"] - ref)) <= 1e-9 * np.abs(ref).max()
+        assert (ref[:, 0] > 0).sum() >= 5
+
+
+def test_curved_master_node_node_error_names_the_cause(matching):
+    # The block as slave against the curved cylinder with node–node pairs: the nodes do face
+    # each other, but not along the cylinder's normals. The message says so and names the
+    # pairing that works.
+    msh, cells, facets, geo = matching
+    with pytest.raises(ValueError, match=r"face each other one to one.*node_to_surface"):
+        _hertz2d_problem(msh, cells, facets, slave=tags.MASTER, master=tags.SLAVE)
+
+
+def test_bad_pairing_name(matching):
+    with pytest.raises(ValueError, match=r"pairing='mortar'.*node_to_surface"):
+        fc.ContactInterface(matching[2], tags.SLAVE, tags.MASTER, 0.0, pairing="mortar")
+    with pytest.raises(ValueError, match=r"zone_edge='loud'"):
+        fc.ContactInterface(matching[2], tags.SLAVE, tags.MASTER, 0.0, zone_edge="loud")
+
+
+@pytest.fixture(scope="module", params=["cylinder", "block"])
+def nonmatching(request, tmp_path_factory):
+    return request.param, run_demo("hertz2d_nonmatching", "--slave", request.param,
+                                   "--refine", NONMATCHING_REFINE, "--no-plot",
+                                   results=tmp_path_factory.mktemp("nm"))
+
+
+def test_hertz_nonmatching_either_slave(nonmatching):
+    slave, (s, folder) = nonmatching
+    assert folder.name == f"hertz2d_nonmatching_{slave}"
+    assert_inputs(s, {"block": STEEL, "cylinder": STEEL}, R_m=R_HERTZ, a_target_m=A_TARGET,
+                  slave=slave)
+    a_ref, p0_ref = analytic.hertz_cylinder(s["P"], R_HERTZ, ESTAR_STEEL)
+    assert s["a_ref"] == pytest.approx(a_ref, rel=1e-12, abs=0)
+    assert abs(s["a"] / a_ref - 1) < 0.02, s["a_error_rel"]
+    assert abs(s["p0"] / p0_ref - 1) < 0.02, s["p0_error_rel"]
+    # Non-matching: the two zones' spacings differ.
+    assert s["mesh"]["h_block_m"] != pytest.approx(s["mesh"]["h_cylinder_m"], rel=0.05)
+    # One factorization; pairs re-made before every increment.
+    assert s["factorizations"] == 1
+    assert s["pairings"] == len(s["increments"]) + 1
+    assert all(not inc["zone_edge"] for inc in s["increments"])
+
+
+@pytest.mark.mpi
+def test_hertz_nonmatching_mpi_equals_serial(nonmatching, tmp_path):
+    slave, (serial, _) = nonmatching
+    par, _ = run_demo("hertz2d_nonmatching", "--slave", slave, "--refine", NONMATCHING_REFINE,
+                      "--no-plot", results=tmp_path, ranks=2)
+    for key in ("P", "a", "p0"):
+        assert par[key] == pytest.approx(serial[key], rel=1e-10, abs=0), key
+    p_s, p_p = np.array(serial["profile"]["pressure"]), np.array(par["profile"]["pressure"])
+    assert np.max(np.abs(p_s - p_p)) <= 1e-10 * np.max(np.abs(p_s))
+
+
+@pytest.fixture(scope="module")
+def rigid_cylinder(tmp_path_factory):
+    return run_demo("rigid_cylinder", "--refine", RIGID_REFINE, "--no-plot",
+                    results=tmp_path_factory.mktemp("rc"))
+
+
+def test_rigid_cylinder_on_block(rigid_cylinder):
+    s, folder = rigid_cylinder
+    assert_inputs(s, {"block": STEEL}, R_m=R_HERTZ, a_target_m=A_TARGET)
+    a_ref, p0_ref = analytic.hertz_cylinder(s["P"], R_HERTZ, ESTAR_RIGID)
+    assert s["a_ref"] == pytest.approx(a_ref, rel=1e-12, abs=0)
+    assert abs(s["a"] / a_ref - 1) < 0.05, s["a_error_rel"]
+    assert abs(s["p0"] / p0_ref - 1) < 0.05, s["p0_error_rel"]
+    assert s["factorizations"] == 1
+    assert s["max_penetration_rel"] <= 1e-8
+
+
+@pytest.mark.mpi
+def test_rigid_cylinder_mpi_equals_serial(rigid_cylinder, tmp_path):
+    serial, _ = rigid_cylinder
+    par, _ = run_demo("rigid_cylinder", "--refine", RIGID_REFINE, "--no-plot",
+                      results=tmp_path, ranks=2)
+    for key in ("P", "a", "p0"):
+        assert par[key] == pytest.approx(serial[key], rel=1e-10, abs=0), key
+
+
+@pytest.fixture(scope="module")
+def sphere_on_plane(tmp_path_factory):
+    return run_demo("sphere_on_plane", "--no-plot", results=tmp_path_factory.mktemp("sp"))
+
+
+def test_sphere_on_rigid_plane(sphere_on_plane):
+    s, folder = sphere_on_plane
+    assert_inputs(s, {"column": STEEL}, R_m=R_HERTZ, a_target_m=A_TARGET)
+    a_ref, p0_ref = analytic.hertz_sphere(s["P"], R_HERTZ, ESTAR_RIGID)
+    assert s["a_ref"] == pytest.approx(a_ref, rel=1e-12, abs=0)
+    assert abs(s["a"] / a_ref - 1) < 0.05, s["a_error_rel"]
+    assert abs(s["p0"] / p0_ref - 1) < 0.05, s["p0_error_rel"]
+    assert s["factorizations"] == 1
+
+
+@pytest.mark.mpi
+def test_sphere_on_plane_mpi_equals_serial(sphere_on_plane, tmp_path):
+    serial, _ = sphere_on_plane
+    par, _ = run_demo("sphere_on_plane", "--no-plot", results=tmp_path, ranks=2)
+    for key in ("P", "a", "p0"):
+        assert par[key] == pytest.approx(serial[key], rel=1e-10, abs=0), key
+
+
+def _rigid_block(zone_factor, zone_edge):
+    """The block of hertz2d under a rigid circle; candidate zone w = zone_factor·a."""
+    msh, cells, facets, geo = hertz2d.build(MPI.COMM_WORLD, R=R_HERTZ, a_expected=A_TARGET,
+                                            zone_factor=zone_factor, with_cylinder=False)
+    V = compat.vector_space(msh)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    a = forms.elasticity_form(u, v, STEEL_M, ufl.dx(domain=msh), "plane_strain")
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    circle = fc.RigidTarget("circle", point_m=(0.0, R_HERTZ), radius_m=R_HERTZ)
+    problem = fc.ContactProblem(a, None, fixed, fc.ContactInterface(
+        facets, tags.MASTER, circle, 0.0, name="probe", zone_edge=zone_edge))
+    return problem, circle, geo
+
+
+def test_zone_guard_warns_and_records():
+    # Pressed to a Hertz half-width of 1.5 w: contact reaches past the candidate zone.
+    problem, circle, geo = _rigid_block(1.0, "warn")
+    w = geo["w"]
+    circle.displacement_m = np.array([0.0, -0.3 * w**2 / (2 * R_HERTZ)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fc.ContactZoneWarning)
+        first = problem.step()           # a shallow approach stays inside
+    assert first.summary.zone_edge == []
+    circle.displacement_m = np.array([0.0, -(1.5 * w) ** 2 / R_HERTZ])
+    if MPI.COMM_WORLD.rank == 0:
+        with pytest.warns(fc.ContactZoneWarning, match=r"probe: increment 2"):
+            inc = problem.step()
+    else:
+        inc = problem.step()
+    assert inc.summary.zone_edge == ["probe"]
+    assert problem.pairings == 3 and problem.factorizations == 1
+
+
+def test_zone_guard_error_keeps_the_increment():
+    problem, circle, geo = _rigid_block(1.0, "error")
+    circle.displacement_m = np.array([0.0, -(1.5 * geo["w"]) ** 2 / R_HERTZ])
+    with pytest.raises(fc.ContactZoneError, match=r"probe: increment 1"):
+        problem.step()
+    assert len(problem.increments) == 1 and problem.increments[0].summary.zone_edge == ["probe"]
