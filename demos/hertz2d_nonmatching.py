@@ -100,7 +100,7 @@ def load(i, t):
 
 
 name = f"hertz2d_nonmatching_{args.slave}"
-folder = fc.results_folder(name)
+folder = fc.results_folder(f"hertz2d_nonmatching/{args.slave}")
 with fc.ResultWriter(folder, name, msh) as out:
     summaries = problem.solve(max(args.increments, 2), load=load, writer=out)
 

@@ -14,6 +14,7 @@ from mpi4py import MPI
 import flexcontact as fc
 from demo_runner import A_TARGET, R_HERTZ, STEEL, assert_inputs, run_demo
 from flexcontact import analytic, compat, forms
+from flexcontact.interface import elliptic_fit
 from flexcontact.meshes import hertz2d, tags
 
 ESTAR_STEEL = analytic.effective_modulus(STEEL["E_Pa"], STEEL["nu"], STEEL["E_Pa"], STEEL["nu"])
@@ -79,18 +80,27 @@ def test_bad_pairing_name(matching):
 def nonmatching(request, tmp_path_factory):
     return request.param, run_demo("hertz2d_nonmatching", "--slave", request.param,
                                    "--refine", NONMATCHING_REFINE, "--no-plot",
-                                   results=tmp_path_factory.mktemp("nm"))
+                                   results=tmp_path_factory.mktemp("nm"),
+                                   subfolder=request.param)
 
 
 def test_hertz_nonmatching_either_slave(nonmatching):
     slave, (s, folder) = nonmatching
-    assert folder.name == f"hertz2d_nonmatching_{slave}"
+    assert (folder / f"hertz2d_nonmatching_{slave}.xdmf").exists()
     assert_inputs(s, {"block": STEEL, "cylinder": STEEL}, R_m=R_HERTZ, a_target_m=A_TARGET,
                   slave=slave)
     a_ref, p0_ref = analytic.hertz_cylinder(s["P"], R_HERTZ, ESTAR_STEEL)
     assert s["a_ref"] == pytest.approx(a_ref, rel=1e-12, abs=0)
-    assert abs(s["a"] / a_ref - 1) < 0.02, s["a_error_rel"]
-    assert abs(s["p0"] / p0_ref - 1) < 0.02, s["p0_error_rel"]
+    # a and p0 of the elliptic fit, recomputed here from the nodal pressures the demo wrote.
+    x, p = np.array(s["profile"]["x"]), np.array(s["profile"]["pressure"])
+    a_fit, p0_fit = elliptic_fit(x, p)
+    assert (a_fit, p0_fit) == pytest.approx((s["a"], s["p0"]), rel=1e-12)
+    assert abs(a_fit / a_ref - 1) < 0.02, s["a_error_rel"]
+    assert abs(p0_fit / p0_ref - 1) < 0.02, s["p0_error_rel"]
+    # Single-pass node–surface pressures oscillate from node to node on non-matching meshes
+    # (largest nodal pressure measured +12.0 % with the cylinder as slave, +4.3 % with the
+    # block, RMS deviation 7.2 % and 3.1 % of p0 at refine 2): bounded, not converging.
+    assert abs(p.max() / p0_ref - 1) < 0.15
     # Non-matching: the two zones' spacings differ.
     assert s["mesh"]["h_block_m"] != pytest.approx(s["mesh"]["h_cylinder_m"], rel=0.05)
     # One factorization; pairs re-made before every increment.
@@ -103,7 +113,7 @@ def test_hertz_nonmatching_either_slave(nonmatching):
 def test_hertz_nonmatching_mpi_equals_serial(nonmatching, tmp_path):
     slave, (serial, _) = nonmatching
     par, _ = run_demo("hertz2d_nonmatching", "--slave", slave, "--refine", NONMATCHING_REFINE,
-                      "--no-plot", results=tmp_path, ranks=2)
+                      "--no-plot", results=tmp_path, ranks=2, subfolder=slave)
     for key in ("P", "a", "p0"):
         assert par[key] == pytest.approx(serial[key], rel=1e-10, abs=0), key
     p_s, p_p = np.array(serial["profile"]["pressure"]), np.array(par["profile"]["pressure"])

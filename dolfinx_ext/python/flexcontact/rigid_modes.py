@@ -121,7 +121,7 @@ def check_bodies(K, V, cell_tags, bodies: dict, comm=MPI.COMM_WORLD, rel_tol: fl
             names = [_MODE_NAMES[gdim][i] for i in _name_modes(Y, N)]
             problems.append(f"body '{name}' (cell tag {value}) can move freely: "
                             f"{', '.join(names)} {'is' if len(names) == 1 else 'are'} not "
-                            "prevented by any Dirichlet condition")
+                            "prevented by any Dirichlet condition (a static problem needs "
+                            "every body held)")
     if problems:
-        raise ValueError("the stiffness matrix is singular (a static problem needs every "
-                         "body held by Dirichlet conditions): " + "; ".join(problems))
+        raise ValueError("the stiffness matrix is singular: " + "; ".join(problems))
