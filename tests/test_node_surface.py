@@ -208,3 +208,36 @@ def test_zone_guard_error_keeps_the_increment():
     with pytest.raises(fc.ContactZoneError, match=r"probe: increment 1"):
         problem.step()
     assert len(problem.increments) == 1 and problem.increments[0].summary.zone_edge == ["probe"]
+
+
+@pytest.fixture(scope="module")
+def long_slide(tmp_path_factory):
+    return run_demo("long_slide", "--no-plot", results=tmp_path_factory.mktemp("ls"))
+
+
+def test_long_slide(long_slide):
+    s, folder = long_slide
+    mu = 0.3
+    assert_inputs(s, {"base": STEEL, "block": {"E_Pa": 70e9, "nu": 0.33}}, mu=mu)
+    # Slid at least five element lengths (mean displacement of the block's bottom nodes).
+    assert s["slid_m"] >= 5 * s["h_m"]
+    assert s["h_patch_m"] != pytest.approx(s["h_m"], rel=0.05)       # non-matching
+    # Coulomb in gross slip, recomputed from the forces: |T| = μN within 1 %.
+    N, T = np.array(s["N"]), np.array(s["T"])
+    gross = np.array(s["gross_slip_increments"]) - 1
+    assert gross.size >= 5 * 2 and gross[-1] == len(N) - 1
+    assert np.max(np.abs(T[gross] / (mu * N[gross]) - 1)) < 0.01
+    assert s["max_penetration_m"] <= 1e-6 * s["h_m"]
+    assert s["factorizations"] == 1
+    assert s["pairings"] == len(N) + 1
+    assert all(not inc["zone_edge"] for inc in s["increments"])
+
+
+@pytest.mark.mpi
+def test_long_slide_mpi_equals_serial(long_slide, tmp_path):
+    serial, _ = long_slide
+    par, _ = run_demo("long_slide", "--no-plot", results=tmp_path, ranks=2)
+    for key in ("N", "T"):
+        a, b = np.array(par[key]), np.array(serial[key])
+        assert np.max(np.abs(a - b)) <= 1e-10 * np.max(np.abs(b)), key
+    assert par["slid_m"] == pytest.approx(serial["slid_m"], rel=1e-10)
