@@ -241,3 +241,43 @@ def test_long_slide_mpi_equals_serial(long_slide, tmp_path):
         a, b = np.array(par[key]), np.array(serial[key])
         assert np.max(np.abs(a - b)) <= 1e-10 * np.max(np.abs(b)), key
     assert par["slid_m"] == pytest.approx(serial["slid_m"], rel=1e-10)
+
+
+def test_hertz3d_node_surface_either_slave():
+    # The quarter model of hertz3d.py, one increment: the column's nodes against the flat
+    # block (triangle facets) reproduce node–node exactly; the block's nodes against the
+    # faceted sphere give Hertz's a and p0 (elliptic fit) to the coarse mesh's accuracy.
+    from flexcontact.meshes import hertz3d
+    msh, cells, facets, geo = hertz3d.build(MPI.COMM_WORLD, R=R_HERTZ, a_expected=A_TARGET,
+                                            h_contact=A_TARGET / 6, h_far=0.02, zone_factor=1.6)
+    V = compat.vector_space(msh)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
+    a = forms.elasticity_form(u, v, {tags.BASE: STEEL_M, tags.UPPER: STEEL_M}, dx, "3d")
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    sym_x, _ = fc.dirichlet(V, facets, tags.SYMMETRY_X, components=[0])
+    sym_y, _ = fc.dirichlet(V, facets, tags.SYMMETRY_Y, components=[1])
+    top, (_, _, top_z) = fc.dirichlet(V, facets, tags.LOADED)
+    top_z.value = -1.1 * A_TARGET**2 / R_HERTZ
+    results = {}
+    for name, slave, master, pairing in [
+            ("node-node", tags.SLAVE, tags.MASTER, "node_to_node"),
+            ("column", tags.SLAVE, tags.MASTER, "node_to_surface"),
+            ("block", tags.MASTER, tags.SLAVE, "node_to_surface")]:
+        problem = fc.ContactProblem(a, None, fixed + sym_x + sym_y + top, fc.ContactInterface(
+            facets, slave, master, 0.0, pairing=pairing))
+        inc = problem.step()
+        if MPI.COMM_WORLD.rank == 0:
+            pr = problem.pairs
+            results[name] = (np.hypot(pr.x[:pr.m, 0], pr.x[:pr.m, 1]), inc.lam,
+                             inc.lam[:, 0] / pr.area, 4 * inc.summary.normal_force)
+    if MPI.COMM_WORLD.rank != 0:
+        return
+    ref = results["node-node"][1]
+    assert np.max(np.abs(results["column"][1] - ref)) <= 1e-9 * np.abs(ref).max()
+    for name in ("column", "block"):
+        r, _, p, P = results[name]
+        a_ref, p0_ref = analytic.hertz_sphere(P, R_HERTZ, ESTAR_STEEL)
+        a_fit, p0_fit = elliptic_fit(r, p)
+        assert abs(a_fit / a_ref - 1) < 0.05, (name, a_fit / a_ref - 1)
+        assert abs(p0_fit / p0_ref - 1) < 0.05, (name, p0_fit / p0_ref - 1)
