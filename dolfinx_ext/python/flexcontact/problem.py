@@ -147,6 +147,9 @@ class ContactProblem:
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
+    Node–surface and rigid-target pairs are re-made before every increment (``repair``);
+    ``factorizations`` counts the sparse factorizations (one) and ``pairings`` how often
+    the pairs were made.
     """
 
     def __init__(self, a: ufl.Form, L: Optional[ufl.Form], bcs: Sequence[DirichletBC],
