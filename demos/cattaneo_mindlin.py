@@ -92,7 +92,7 @@ def load(i, t):
 
 
 folder = fc.results_folder("cattaneo_mindlin")
-with fc.ResultWriter(folder, "cattaneo_mindlin", msh) as out:
+with fc.ResultWriter(folder, "cattaneo_mindlin", msh, tags=(cells,)) as out:
     summaries = problem.solve(n1 + n2, load=load, writer=out)
 
 # %% [markdown]

@@ -90,7 +90,7 @@ def load(i, t):
 
 
 folder = fc.results_folder("hertz2d")
-with fc.ResultWriter(folder, "hertz2d", msh) as out:
+with fc.ResultWriter(folder, "hertz2d", msh, tags=(cells,)) as out:
     summaries = problem.solve(max(args.increments, 2), load=load, writer=out)
 
 # %% [markdown]

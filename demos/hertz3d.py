@@ -112,7 +112,7 @@ def load(i, t):
 
 
 folder = fc.results_folder("hertz3d")
-with fc.ResultWriter(folder, "hertz3d", msh) as out:
+with fc.ResultWriter(folder, "hertz3d", msh, tags=(cells,)) as out:
     summaries = problem.solve(max(args.increments, 2), load=load, writer=out)
 
 # %% [markdown]

@@ -82,7 +82,7 @@ def load(i, t):
 
 folder = fc.results_folder("sliding_block")
 pushes = []
-with fc.ResultWriter(folder, "sliding_block", msh) as out:
+with fc.ResultWriter(folder, "sliding_block", msh, tags=(cells,)) as out:
     summaries = problem.solve(n1 + n2, load=lambda i, t: (load(i, t), pushes.append(float(top_x.value))),
                               writer=out)
 

@@ -155,7 +155,7 @@ def load(i, t):
 
 
 folder = fc.results_folder("sliding_block_3d")
-with fc.ResultWriter(folder, "sliding_block_3d", msh) as out:
+with fc.ResultWriter(folder, "sliding_block_3d", msh, tags=(cells,)) as out:
     summaries = problem.solve(n1 + n2, load=load, writer=out)
 pad.append(pad_force_N())
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Install what is needed, build, and run the main demo; outputs land in results/.
+# Install what is needed, build, and run the main job (the dam–log demo); outputs land in
+# results/dam_debris/.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bash "$here/scripts/setup.sh"
 cd "$here"
-/usr/bin/python3 demos/hertz2d.py "$@"
-echo "Outputs: $here/results/hertz2d/ (hertz2d.xdmf for ParaView, hertz2d.png, summary.json)"
+/usr/bin/python3 demos/dam_debris.py "$@"
+echo "Outputs: $here/results/dam_debris/ (XDMF for ParaView, PNG pictures, summary.json)"

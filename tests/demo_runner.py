@@ -4,6 +4,8 @@ import os
 import subprocess
 from pathlib import Path
 
+import numpy as np
+
 from conftest import ROOT, mpirun
 
 
@@ -50,3 +52,29 @@ def first_gross_slip(s, n1=NORMAL_INCREMENTS):
     """Index of the first increment after the normal stage in which no pair sticks."""
     return next(i for i, inc in enumerate(s["increments"])
                 if i >= n1 and inc["stick"] == 0 and inc["slip"] > 0)
+
+
+DEMO_FIELDS = {"displacement": "Node", "contact_pressure": "Node",
+               "tangential_traction": "Node", "contact_status": "Node", "von_mises": "Cell",
+               "cell_tag": "Cell"}
+
+
+def assert_xdmf(s, folder, name):
+    """The demo's XDMF: one Grid per increment on one mesh, holding every field (double
+    precision) and the two bodies' tags; the last step's contact pressure at the slave
+    nodes equal to the summary's profile where the summary has one (2D, along x)."""
+    from xdmf_case import read
+    steps = read(folder / f"{name}.xdmf")
+    assert [st["t"] for st in steps] == [float(i + 1) for i in range(len(s["increments"]))]
+    assert len({st["seeks"] for st in steps}) == 1
+    for st in steps:
+        assert {k: v[0] for k, v in st["attributes"].items()} == DEMO_FIELDS
+        assert all(v[2] == "8" for k, v in st["attributes"].items() if k != "cell_tag")
+    last = steps[-1]["attributes"]
+    assert set(np.unique(last["cell_tag"][3])) == {1, 2}
+    if "profile" in s and np.ptp(steps[-1]["x"][:, 2]) == 0:
+        x, pressure = steps[-1]["x"], last["contact_pressure"][3][:, 0]
+        scale = max(s["profile"]["pressure"])
+        for xi, pi in zip(s["profile"]["x"], s["profile"]["pressure"]):
+            at = np.abs(x[:, 0] - xi) <= 1e-12 * np.abs(x).max()
+            assert np.any(np.abs(pressure[at] - pi) <= 1e-12 * scale), (xi, pi)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from demo_runner import (A_TARGET, ALUMINIUM, MU, NORMAL_INCREMENTS, R_HERTZ, STEEL,
-                         assert_inputs, first_gross_slip, run_demo)
+                         assert_inputs, assert_xdmf, first_gross_slip, run_demo)
 from flexcontact import analytic
 
 ESTAR_STEEL = analytic.effective_modulus(STEEL["E_Pa"], STEEL["nu"], STEEL["E_Pa"], STEEL["nu"])
@@ -53,7 +53,7 @@ def test_hertz3d_radius_and_peak_pressure(hertz):
     assert s["P_target"] == pytest.approx(P_target, rel=1e-12, abs=0)
     assert s["P"] == pytest.approx(P_target, rel=0.05)
     assert s["max_penetration_rel"] <= 1e-8
-    assert (folder / "hertz3d.xdmf").exists() and (folder / "hertz3d.h5").exists()
+    assert_xdmf(s, folder, "hertz3d")
     assert (folder / "hertz3d.png").stat().st_size > 10_000
 
 
@@ -107,7 +107,7 @@ def test_sliding_block_3d_coulomb_bound_and_sliding_force(sliding):
     # The block stuck first: T grew through several tangential increments before sliding.
     assert s["slip_onset_increment"] >= 2 + 4
     assert (folder / "sliding_block_3d.png").exists()
-    assert (folder / "sliding_block_3d.xdmf").exists()
+    assert_xdmf(s, folder, "sliding_block_3d")
 
 
 def test_sliding_block_3d_friction_follows_the_turning_slip(sliding):

@@ -143,13 +143,25 @@ def facet_dim(msh) -> int:
     return msh.topology.dim - 1
 
 
-def write_mesh_and_tags(xdmf, msh, tags=()):
-    xdmf.write_mesh(msh)
-    for t in tags:
-        if NEW_API:
-            xdmf.write_meshtags(t, msh.geometry)
-        else:
-            xdmf.write_meshtags(t)
+def input_node_indices(msh) -> np.ndarray:
+    """Index in the mesh's input of each local geometry node: the same node has the same
+    number in serial and on any number of ranks."""
+    return np.asarray(cpp(msh.geometry).input_global_indices, dtype=np.int64)
+
+
+def original_cell_indices(msh) -> np.ndarray:
+    """Index in the mesh's input of each local cell (owned first), rank-independent."""
+    return np.asarray(cpp(msh.topology).original_cell_index, dtype=np.int64)
+
+
+def same_mesh(a, b) -> bool:
+    """True if the two DOLFINx meshes are one and the same."""
+    return cpp(a.topology) is cpp(b.topology)
+
+
+def cell_type_name(msh) -> str:
+    """"triangle", "tetrahedron", "quadrilateral", ... (single cell type meshes)."""
+    return msh.topology.cell_type.name
 
 
 def locate_component_dofs(V, component: int, facet_indices):
@@ -170,3 +182,27 @@ def create_petsc_vector(V):
     """A ghosted PETSc vector laid out like the Function space's DOFs."""
     import dolfinx.la
     return dolfinx.la.create_petsc_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+
+
+def points_in_cells(msh, points) -> tuple[np.ndarray, np.ndarray]:
+    """Which of ``points`` (n, 3) lie in this rank's cells: (point indices, one cell each).
+
+    A point on a cell boundary is given one of its cells; points outside every local cell
+    (owned or ghost) are left out."""
+    import dolfinx.geometry as geometry
+    tdim = msh.topology.dim
+    points = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+    if NEW_API:
+        tree = geometry.bb_tree(msh, tdim)
+        candidates = geometry.compute_collisions_points(tree, points)
+    else:
+        tree = geometry.BoundingBoxTree(msh, tdim)
+        candidates = geometry.compute_collisions(tree, points)
+    colliding = geometry.compute_colliding_cells(msh, candidates, points)
+    found, cells = [], []
+    for i in range(points.shape[0]):
+        links = colliding.links(i)
+        if len(links):
+            found.append(i)
+            cells.append(links[0])
+    return np.array(found, dtype=np.int64), np.array(cells, dtype=np.int32)

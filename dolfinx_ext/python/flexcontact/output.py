@@ -1,4 +1,4 @@
-"""Results on disk: XDMF time series for ParaView, summary.json, the increment table."""
+"""Results on disk: the XDMF time series for ParaView, summary.json, the increment table."""
 from __future__ import annotations
 
 import json
@@ -10,42 +10,82 @@ from typing import TYPE_CHECKING, Sequence, Union
 import numpy as np
 from mpi4py import MPI
 
-import dolfinx.io
-
-from . import compat
+from .xdmf import XdmfSeries
+from .xdmf_gather import MeshGather, raise_on_any_rank
 
 # DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never imported at run time.
 if TYPE_CHECKING:
+    from dolfinx.fem import Function
     from dolfinx.mesh import Mesh, MeshTags
 
     from .problem import ContactProblem
 
 
 class ResultWriter:
-    """One XDMF file, one time step per increment; closed (and so complete) on every exit.
+    """``<name>.xdmf`` (+ ``<name>.bin``): one time step per :meth:`write`, every field of a
+    step on one mesh in double precision (see :mod:`flexcontact.xdmf`).
 
-    Use as a context manager so that a failing increment leaves a readable file with the
-    increments done before it.
+    The file is complete after every step, so a failing increment leaves a readable file with
+    the increments done before it; use as a context manager all the same, so that the data
+    file is closed. Cell tags (``tags``) are written at every step as integer cell attributes
+    (``cell_tag`` for DOLFINx's default names, else the tags' name). Collective on the mesh's
+    communicator; rank 0 writes, and the file is the same on any number of ranks.
     """
 
     def __init__(self, folder: Union[str, os.PathLike], name: str, msh: Mesh,
                  tags: Sequence[MeshTags] = ()):
         self.folder = Path(folder)
-        if msh.comm.rank == 0:
-            self.folder.mkdir(parents=True, exist_ok=True)
-        msh.comm.barrier()
         self.path = self.folder / f"{name}.xdmf"
-        self._xdmf = dolfinx.io.XDMFFile(msh.comm, str(self.path), "w")
-        compat.write_mesh_and_tags(self._xdmf, msh, tags)
+        self.comm = msh.comm
+        if hasattr(tags, "indices"):  # one MeshTags rather than a sequence of them
+            tags = (tags,)
+        self._mesh = MeshGather(msh)
+        static = self._mesh.cell_tags(tuple(tags))
+        self._series = None
+        error = None
+        if self.comm.rank == 0:
+            try:
+                self.folder.mkdir(parents=True, exist_ok=True)
+                self._series = XdmfSeries(self.path, self._mesh.topology_type, self._mesh.x,
+                                          self._mesh.cells, static)
+            except OSError as e:
+                error = f"ResultWriter: cannot write {self.path}: {e}"
+        raise_on_any_rank(self.comm, error, OSError)
 
-    def write(self, problem: ContactProblem, t: float) -> None:
-        for f in problem.fields():
-            self._xdmf.write_function(f, t)
+    def write(self, obj: Union[ContactProblem, Sequence[Function], Function],
+              t: float) -> None:
+        """Write the fields of ``obj`` at time ``t`` as one step (collective).
+
+        ``obj`` is anything with a ``fields()`` method returning DOLFINx Functions (a
+        ContactProblem), a sequence of Functions, or one Function: continuous degree-1 fields
+        become node attributes, DG0 fields cell attributes, 2D vectors padded to 3D.
+        """
+        if hasattr(obj, "fields"):
+            functions = list(obj.fields())
+        elif hasattr(obj, "function_space"):
+            functions = [obj]
+        else:
+            functions = list(obj)
+        message = None
+        if self._mesh is None:
+            message = f"ResultWriter: {self.path} is closed"
+        elif not np.isfinite(t):
+            message = f"ResultWriter: time t = {t} is not finite"
+        raise_on_any_rank(self.comm, message)
+        fields = self._mesh.gather(functions)
+        error = None
+        if self._series is not None:
+            try:
+                self._series.add_step(float(t), fields)
+            except OSError as e:
+                error = f"ResultWriter: cannot write {self.path}: {e}"
+        raise_on_any_rank(self.comm, error, OSError)
 
     def close(self) -> None:
-        if self._xdmf is not None:
-            self._xdmf.close()
-            self._xdmf = None
+        if self._series is not None:
+            self._series.close()
+            self._series = None
+        self._mesh = None
 
     def __enter__(self) -> ResultWriter:
         return self

@@ -42,9 +42,10 @@ std::vector<std::string> solver_names();
 std::vector<std::string> default_chain();
 
 /// @brief Try the solvers of opt.chain (or default_chain()) in order until one converges.
-/// With the default chain, 50 projection sweeps come first as a warm start (recorded in
-/// `attempts`): they settle most pairs' states cheaply, and Newton then needs a step or two.
-/// The report is the converging solver's, with `attempts` listing every try; if none
+/// With the default chain and 300 unknowns or more, 50 projection sweeps come first as a
+/// warm start (recorded in `attempts`): they settle most pairs' states cheaply, and Newton
+/// then needs a step or two. Each solver is tried from the best answer so far and from the
+/// caller's start (the active set from the caller's first). The report is the converging solver's, with `attempts` listing every try; if none
 /// converges it is the best one's (smallest residual) with converged=false.
 SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                   const std::vector<PairState>& states0, const SolverOptions& opt);

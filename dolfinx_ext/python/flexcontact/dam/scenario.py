@@ -1,0 +1,230 @@
+"""One debris-impact scenario of a concrete gravity dam: every parameter, checked up front.
+
+Axes: x points downstream, the vertical axis is the last one (y in 2D, z in 3D), and in 3D y
+runs along the dam axis (0 ≤ y ≤ ``dam_width_m``). The heel is the origin: the vertical
+upstream face is x = 0 and the dam's base (its interface with the foundation) is the
+vertical coordinate 0. The profile is the usual one: a crest of width ``crest_width_m``, a
+vertical downstream face under the crest down to the *knee*, then the downstream slope
+(``downstream_slope`` horizontal per vertical) down to the toe at x = B = slope · height
+(the slope line runs through the upstream crest corner).
+
+The log floats: its axis elevation follows from the water level and its draft (see
+:mod:`flexcontact.dam.floating`); it is pitched (front end up for a positive angle) and, in
+3D, yawed about the vertical axis, and is placed so that its point nearest the dam is
+``log_gap_m`` upstream of the face, at mid-width of the block in 3D. A pitched log keeps the
+centre elevation of the horizontal floating log (exact for s = 1/2 by the symmetry of the
+segment area about d = R, a small-angle approximation otherwise).
+
+Materials: concrete and foundation rock are isotropic. Wood is modelled isotropic with the
+along-grain modulus, because a log hits nearly end-on and then its axial stiffness governs
+the impact; the across-grain modulus is kept (``wood_E_across_grain_Pa``) for reports, not
+used by the model.
+
+Stage-2 parameters are held and checked here too: the log's speed, the friction coefficient,
+the log's added-mass coefficient and the optional Westergaard added mass of the reservoir.
+``added_mass_coefficient`` C_a multiplies the mass of the water the log displaces, which for
+a floating log equals the log's own mass: m_effective = (1 + C_a) m_log. Its default 0.05
+covers a log moving nearly along its axis: a slender prolate spheroid of the log's aspect
+ratio (L/D = 12.5) has an axial added-mass coefficient of about 0.015 fully submerged; a log
+driven sideways would need about 1.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+from typing import Optional
+
+import numpy as np
+
+from ..forms import Material
+from ..forms.loads import STANDARD_GRAVITY_M_S2, WATER_DENSITY_KG_M3
+from .floating import floating_draft_m
+
+CONCRETE = Material(E_Pa=25e9, nu=0.2, rho_kg_m3=2400.0, name="concrete")
+"""Mass concrete of a gravity dam."""
+ROCK = Material(E_Pa=20e9, nu=0.25, rho_kg_m3=2600.0, name="rock")
+"""Sound foundation rock (deformation modulus)."""
+WOOD = Material(E_Pa=10e9, nu=0.3, rho_kg_m3=650.0, name="wood")
+"""Green softwood log, isotropic with the along-grain modulus."""
+
+_DEFAULT_MESH = {2: (3.0, 0.2), 3: (6.0, 0.4)}  # (far, impact) element sizes in m by dimension
+
+
+@dataclass(frozen=True)
+class DamScenario:
+    """All parameters of one scenario, in SI units; raises ValueError on a bad one.
+
+    Construct with keywords and derive variants with :meth:`replace`. Every check runs in
+    the constructor, so nothing is meshed or computed for a bad scenario.
+    """
+
+    dim: int = 2
+    # dam and foundation (m)
+    dam_height_m: float = 30.0
+    crest_width_m: float = 5.0
+    downstream_slope: float = 0.8
+    dam_width_m: float = 15.0
+    foundation_depth_m: float = 30.0
+    foundation_upstream_m: float = 30.0
+    foundation_downstream_m: float = 30.0
+    # water (m above the base)
+    water_level_m: float = 27.0
+    tailwater_level_m: float = 0.0
+    uplift_factor: float = 0.0
+    # log (m, degrees)
+    log_length_m: float = 10.0
+    log_diameter_m: float = 0.8
+    log_pitch_deg: float = 10.0
+    log_yaw_deg: float = 0.0
+    log_gap_m: float = 0.02
+    # stage 2 (impact)
+    log_speed_m_s: float = 2.0
+    friction_mu: float = 0.5
+    added_mass_coefficient: float = 0.05
+    westergaard: bool = False
+    # materials and strengths
+    concrete: Material = CONCRETE
+    rock: Material = ROCK
+    wood: Material = WOOD
+    wood_E_across_grain_Pa: float = 0.6e9
+    wood_crushing_strength_Pa: float = 20e6
+    concrete_tensile_strength_Pa: float = 2.5e6
+    water_density_kg_m3: float = WATER_DENSITY_KG_M3
+    gravity_m_s2: float = STANDARD_GRAVITY_M_S2
+    # mesh
+    mesh_size_far_m: Optional[float] = None
+    mesh_size_impact_m: Optional[float] = None
+    impact_zone_m: float = 1.0
+    refine: int = 0
+
+    def __post_init__(self):
+        from .validate import check_scenario
+        check_scenario(self)
+
+    def replace(self, **changes) -> DamScenario:
+        """A copy with some parameters changed (checked again)."""
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict:
+        """Plain parameters for a summary (materials as dicts)."""
+        out = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            out[f.name] = ({"E_Pa": v.E_Pa, "nu": v.nu, "rho_kg_m3": v.rho_kg_m3}
+                           if isinstance(v, Material) else v)
+        return out
+
+    # ---- dam profile -------------------------------------------------------------------
+    @property
+    def base_width_m(self) -> float:
+        """B = slope · height: heel at x = 0, toe at x = B."""
+        return self.downstream_slope * self.dam_height_m
+
+    @property
+    def knee_elevation_m(self) -> float:
+        """Where the downstream slope meets the vertical face under the crest."""
+        return self.dam_height_m - self.crest_width_m / self.downstream_slope
+
+    def downstream_face_x_m(self, elevation_m: float) -> float:
+        """x of the downstream face at a given elevation."""
+        if elevation_m >= self.knee_elevation_m:
+            return self.crest_width_m
+        return self.base_width_m - self.downstream_slope * elevation_m
+
+    def dam_outline(self) -> list:
+        """Profile corners (x, vertical) counter-clockwise from the heel: heel, toe, knee,
+        crest downstream, crest upstream."""
+        H, B, bc, yk = (self.dam_height_m, self.base_width_m, self.crest_width_m,
+                        self.knee_elevation_m)
+        return [(0.0, 0.0), (B, 0.0), (bc, yk), (bc, H), (0.0, H)]
+
+    @property
+    def vertical_axis(self) -> int:
+        return self.dim - 1
+
+    @property
+    def h_far_m(self) -> float:
+        h = self.mesh_size_far_m or _DEFAULT_MESH[self.dim][0]
+        return h / 2 ** self.refine
+
+    @property
+    def h_impact_m(self) -> float:
+        h = self.mesh_size_impact_m or _DEFAULT_MESH[self.dim][1]
+        return min(h / 2 ** self.refine, self.h_far_m)
+
+    # ---- water -------------------------------------------------------------------------
+    def hydrostatic_resultant_N_per_m(self) -> float:
+        """ρ_w g h²/2 on the upstream face per unit width, acting at h/3 above the base."""
+        return 0.5 * self.water_density_kg_m3 * self.gravity_m_s2 * self.water_level_m ** 2
+
+    # ---- log ---------------------------------------------------------------------------
+    @property
+    def log_radius_m(self) -> float:
+        return 0.5 * self.log_diameter_m
+
+    @property
+    def log_density_ratio(self) -> float:
+        return self.wood.rho_kg_m3 / self.water_density_kg_m3
+
+    @property
+    def log_draft_m(self) -> float:
+        return floating_draft_m(self.log_radius_m, self.log_density_ratio)
+
+    @property
+    def log_axis_elevation_m(self) -> float:
+        """Elevation of the floating log's axis: water level − draft + radius."""
+        return self.water_level_m - self.log_draft_m + self.log_radius_m
+
+    @property
+    def log_axis(self) -> np.ndarray:
+        """Unit vector along the log, pointing at the dam (front end)."""
+        t, p = math.radians(self.log_pitch_deg), math.radians(self.log_yaw_deg)
+        if self.dim == 2:
+            return np.array([math.cos(t), math.sin(t)])
+        return np.array([math.cos(t) * math.cos(p), math.cos(t) * math.sin(p), math.sin(t)])
+
+    def _log_reach(self, direction: np.ndarray) -> float:
+        """Largest extent of the log beyond its centre along a unit ``direction``."""
+        a, R, L = self.log_axis, self.log_radius_m, self.log_length_m
+        c = abs(float(a @ direction))
+        # Support function of the 2D rectangle and of the 3D cylinder alike.
+        return 0.5 * L * c + R * math.sqrt(max(1.0 - c * c, 0.0))
+
+    @property
+    def log_centre(self) -> np.ndarray:
+        """Centre of the log (m): the nearest point to the dam is ``log_gap_m`` from x = 0."""
+        ex = np.eye(self.dim)[0]
+        c = np.zeros(self.dim)
+        c[0] = -self.log_gap_m - self._log_reach(ex)
+        c[-1] = self.log_axis_elevation_m
+        if self.dim == 3:
+            c[1] = 0.5 * self.dam_width_m
+        return c
+
+    @property
+    def log_front_point(self) -> np.ndarray:
+        """The log's point nearest the dam (first contact): a corner of the front end, or
+        the front end's centre for a log square to the face."""
+        a, R = self.log_axis, self.log_radius_m
+        ex = np.eye(self.dim)[0]
+        radial = ex - (a @ ex) * a
+        n = np.linalg.norm(radial)
+        offset = R * radial / n if n > 1e-12 else np.zeros(self.dim)
+        return self.log_centre + 0.5 * self.log_length_m * a + offset
+
+    @property
+    def log_lowest_elevation_m(self) -> float:
+        ez = np.eye(self.dim)[-1]
+        return float(self.log_centre[-1] - self._log_reach(ez))
+
+    def log_mass_kg(self) -> float:
+        """Mass of the cylindrical log, ρ π R² L (kg)."""
+        return self.wood.rho_kg_m3 * math.pi * self.log_radius_m ** 2 * self.log_length_m
+
+    def log_mass_2d_kg_per_m(self) -> float:
+        """Mass per unit width of the plane-strain log (a slab L × D), ρ L D (kg/m)."""
+        return self.wood.rho_kg_m3 * self.log_length_m * self.log_diameter_m
+
+    def log_added_mass_kg(self) -> float:
+        """C_a times the displaced water's mass (= the floating log's mass), kg."""
+        return self.added_mass_coefficient * self.log_mass_kg()

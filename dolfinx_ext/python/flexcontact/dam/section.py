@@ -1,0 +1,173 @@
+"""What dam engineers read off a model: base-section resultants, heel and toe stresses, and
+peak stresses at a stated distance from a point.
+
+Axes as in :mod:`flexcontact.dam.scenario` (x downstream, vertical last, heel at the
+origin). Sign conventions:
+
+* ``force_N``: the force the dam transmits to the foundation through its base (the resultant
+  of every load on the dam); ``normal_force_N`` N = −(its vertical component), compression
+  positive; ``shear_force_N`` its downstream component.
+* moments tip the dam downstream when positive (clockwise in the 2D x–y picture; about +y in
+  3D), about the heel or about the base's centre.
+* stresses σ (normal to the base, tension positive) by linearisation over the base of width B
+  and block width w (w = 1 m in 2D, every value then per metre of dam):
+
+      σ_heel = −N/(B w) + 6 M_c/(w B²),   σ_toe = −N/(B w) − 6 M_c/(w B²)
+
+  with M_c the moment about the base's centre.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from .. import compat
+
+
+def tipping_moment(arm: np.ndarray, force: np.ndarray) -> np.ndarray:
+    """Downstream-tipping moment of forces (rows) at arms (rows) from the moment point."""
+    if arm.shape[1] == 2:
+        return -(arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0])
+    return arm[:, 2] * force[:, 0] - arm[:, 0] * force[:, 2]
+
+
+@dataclass(frozen=True)
+class BaseSection:
+    """Resultant transmitted through the base: force (N; N/m in 2D) and moment about the
+    heel (N·m; N·m/m in 2D), for a base of width ``base_width_m`` and a block of width
+    ``width_m`` (1 in 2D)."""
+
+    force_N: tuple
+    moment_heel_Nm: float
+    base_width_m: float
+    width_m: float = 1.0
+
+    @classmethod
+    def from_forces(cls, points, forces, base_width_m, width_m=1.0, comm=None):
+        """Sum nodal forces (rows of ``forces``) at ``points`` (heel at the origin); with
+        ``comm`` the sums run over every rank (each rank passing only what it owns)."""
+        points, forces = np.atleast_2d(points), np.atleast_2d(forces)
+        f = forces.sum(axis=0)
+        m = float(tipping_moment(points, forces).sum()) if len(points) else 0.0
+        if comm is not None:
+            f = comm.allreduce(f, op=MPI.SUM)
+            m = comm.allreduce(m, op=MPI.SUM)
+        return cls(tuple(float(x) for x in f), m, float(base_width_m), float(width_m))
+
+    def plus(self, force, point) -> BaseSection:
+        """The section with one more load (``force`` at ``point``) on the dam."""
+        force = np.asarray(force, dtype=float)
+        m = tipping_moment(np.atleast_2d(point), np.atleast_2d(force))[0]
+        return BaseSection(tuple(np.asarray(self.force_N) + force), self.moment_heel_Nm + m,
+                           self.base_width_m, self.width_m)
+
+    @property
+    def normal_force_N(self) -> float:
+        return -self.force_N[-1]
+
+    @property
+    def shear_force_N(self) -> float:
+        return self.force_N[0]
+
+    @property
+    def moment_centre_Nm(self) -> float:
+        return self.moment_heel_Nm - 0.5 * self.base_width_m * self.normal_force_N
+
+    @property
+    def sigma_heel_Pa(self) -> float:
+        B, w = self.base_width_m, self.width_m
+        return -self.normal_force_N / (B * w) + 6.0 * self.moment_centre_Nm / (w * B * B)
+
+    @property
+    def sigma_toe_Pa(self) -> float:
+        B, w = self.base_width_m, self.width_m
+        return -self.normal_force_N / (B * w) - 6.0 * self.moment_centre_Nm / (w * B * B)
+
+    def as_dict(self) -> dict:
+        return {"normal_force_N": self.normal_force_N, "shear_force_N": self.shear_force_N,
+                "moment_heel_Nm": self.moment_heel_Nm, "moment_centre_Nm": self.moment_centre_Nm,
+                "sigma_heel_Pa": self.sigma_heel_Pa, "sigma_toe_Pa": self.sigma_toe_Pa}
+
+
+def nodal_forces(V, form, facet_tags=None, tag=None) -> tuple[np.ndarray, np.ndarray]:
+    """Assemble the linear ``form`` and return this rank's owned nodal forces (n, gdim) and
+    their points (n, gdim), on the nodes of facets tagged ``tag`` (all nodes if None)."""
+    import dolfinx.fem
+    import dolfinx.fem.petsc
+    msh = V.mesh
+    r = compat.create_petsc_vector(V)
+    r.zeroEntries()
+    dolfinx.fem.petsc.assemble_vector(r, form)
+    r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    n_owned = V.dofmap.index_map.size_local
+    if tag is None:
+        owned = np.arange(n_owned, dtype=np.int32)
+    else:
+        facets = facet_tags.indices[facet_tags.values == tag]
+        blocks = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim - 1, facets)
+        owned = blocks[blocks < n_owned]
+    gdim = msh.geometry.dim
+    values = r.array_r.reshape(-1, gdim)[owned].copy()
+    r.destroy()
+    return V.tabulate_dof_coordinates()[owned, :gdim], values
+
+
+def nodal_section(V, residual_form, facet_tags, base_tag: int, base_width_m: float,
+                  width_m: float = 1.0) -> BaseSection:
+    """Base section from the nodal forces of one side's residual at the base nodes.
+
+    ``residual_form``: compiled linear form L_side(v) − a_side(u_h, v) of the dam's free body
+    (loads minus internal forces over the dam's cells only). Its value at a base node is the
+    force the dam hands to the foundation there, and elsewhere it vanishes; the sums are
+    those of the loads on the dam, exact in statics whatever the mesh. Collective.
+    """
+    points, values = nodal_forces(V, residual_form, facet_tags, base_tag)
+    return BaseSection.from_forces(points, values, base_width_m, width_m, comm=V.mesh.comm)
+
+
+def sample_directions(dim: int, n: int) -> np.ndarray:
+    """``n`` unit vectors spread evenly on the circle (2D) or the sphere (3D, Fibonacci)."""
+    if dim == 2:
+        t = 2.0 * np.pi * np.arange(n) / n
+        return np.column_stack([np.cos(t), np.sin(t)])
+    k = np.arange(n) + 0.5
+    z = 1.0 - 2.0 * k / n
+    phi = np.pi * (1.0 + 5 ** 0.5) * k
+    r = np.sqrt(1.0 - z * z)
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+
+
+def peak_at_offset(f, point, offset_m: float, cell_tags=None, tag=None, samples: int = 720):
+    """Largest value of the scalar Function ``f`` at distance ``offset_m`` from ``point``.
+
+    Samples the circle (2D) or sphere (3D) of that radius, keeps the points inside the mesh
+    (and inside cells tagged ``tag`` if given) and returns ``(value, where)``: the maximum
+    and the sample point (3 coordinates), or ``(nan, None)`` if no sample lies in the body.
+    Stresses at a re-entrant corner or under a contact edge grow with mesh refinement; at a
+    stated distance they converge, which is what a design check can use. Collective.
+    """
+    if not offset_m > 0:
+        raise ValueError(f"offset_m={offset_m!r}: must be > 0")
+    msh = f.function_space.mesh
+    gdim = msh.geometry.dim
+    pts = np.zeros((samples if gdim == 2 else 4 * samples, 3))
+    dirs = sample_directions(gdim, pts.shape[0])
+    pts[:, :gdim] = np.asarray(point, dtype=float)[:gdim] + offset_m * dirs
+    found, cells = compat.points_in_cells(msh, pts)
+    if cell_tags is not None and tag is not None and len(found):
+        mark = np.zeros(msh.topology.index_map(msh.topology.dim).size_local
+                        + msh.topology.index_map(msh.topology.dim).num_ghosts, dtype=bool)
+        mark[cell_tags.indices[cell_tags.values == tag]] = True
+        keep = mark[cells]
+        found, cells = found[keep], cells[keep]
+    best, where = -np.inf, None
+    if len(found):
+        vals = f.eval(pts[found], cells).reshape(-1)
+        i = int(np.argmax(vals))
+        best, where = float(vals[i]), pts[found[i]]
+    everyone = msh.comm.allgather((best, where))
+    best, where = max(everyone, key=lambda bw: bw[0])
+    return (best, where) if np.isfinite(best) else (float("nan"), None)

@@ -1,0 +1,187 @@
+"""A concrete gravity dam on its foundation and a floating log upstream (2D and 3D).
+
+``build(comm, scenario)`` meshes a :class:`flexcontact.dam.DamScenario` (which holds and
+checks every dimension, see its docstring for the axes and the profile) and returns
+``(mesh, cell_tags, facet_tags, info)`` with the named groups of :mod:`.dam_tags`.
+
+* The dam and the foundation are meshed together and share their nodes along the base (a
+  bonded, conforming interface, tagged ``dam_base``); the log is a separate body sharing no
+  node with them.
+* The upstream face has a node (2D) or an edge (3D) at the water line, and the downstream
+  face one at the tailwater level, so that the hydrostatic pressure, linear on every facet
+  below the water and zero above, is integrated exactly.
+* Elements have the size ``scenario.h_impact_m`` on the log and within
+  ``scenario.impact_zone_m`` of it (so also on the part of the upstream face the log can
+  hit), growing to ``scenario.h_far_m`` away from it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _gmsh
+from .dam_tags import (DAM, DAM_BASE, DAM_CREST, DAM_DOWNSTREAM, DAM_FLANKS, DAM_UPSTREAM,
+                       FOUNDATION, FOUNDATION_BOTTOM, FOUNDATION_FLANKS, FOUNDATION_SIDES, LOG,
+                       LOG_BACK, LOG_FRONT, LOG_LOWER, LOG_MANTLE, LOG_UPPER, NAMES,
+                       RESERVOIR_BED, TAILWATER_BED)
+
+
+def build(comm, scenario):
+    """Mesh ``scenario`` (a checked DamScenario) on ``comm``: 2D or 3D by ``scenario.dim``.
+
+    ``info``: base_width_m, knee_elevation_m, water_level_m, tailwater_level_m, log_centre,
+    log_front_point, log_axis, h_far_m, h_impact_m.
+    """
+    s = scenario
+    info = dict(dim=s.dim, base_width_m=s.base_width_m, knee_elevation_m=s.knee_elevation_m,
+                water_level_m=s.water_level_m, tailwater_level_m=s.tailwater_level_m,
+                log_centre=s.log_centre.tolist(), log_front_point=s.log_front_point.tolist(),
+                log_axis=s.log_axis.tolist(), h_far_m=s.h_far_m, h_impact_m=s.h_impact_m)
+    model = (lambda: _model_2d(s, info)) if s.dim == 2 else (lambda: _model_3d(s, info))
+    return _gmsh.generate(comm, f"dam{s.dim}d", model, gdim=s.dim)
+
+
+def profile_points(s) -> list:
+    """Corners of the dam profile (x, vertical) counter-clockwise from the heel, with the
+    tailwater point on the downstream face and the water-line point on the upstream face
+    (each only when strictly between the ends of its face)."""
+    heel, toe, knee, crest_d, crest_u = s.dam_outline()
+    down = [toe]
+    ht = s.tailwater_level_m
+    if 0 < ht < s.dam_height_m and not np.isclose(ht, knee[1]):
+        down.append((s.downstream_face_x_m(ht), ht))
+    down += [knee, crest_d]
+    down.sort(key=lambda p: p[1])
+    up = [crest_u]
+    if s.water_level_m < s.dam_height_m:
+        up.append((0.0, s.water_level_m))
+    return [heel] + down + up
+
+
+def _refine_near_log(s, log_entities, dim):
+    near = s.impact_zone_m
+    far = near + 2.0 * (s.h_far_m - s.h_impact_m)  # growth rate 1/2: well-shaped grading
+    _gmsh.size_field(log_entities, dim, s.h_impact_m, s.h_far_m, near, far,
+                     points_per_curve=max(20, int(4 * s.log_length_m / s.h_impact_m)))
+
+
+def _model_2d(s, info):
+    import gmsh
+    geo = gmsh.model.geo
+    pts = profile_points(s)
+    B, Lu, Ld, D = s.base_width_m, s.foundation_upstream_m, s.foundation_downstream_m, \
+        s.foundation_depth_m
+    p = [geo.addPoint(x, y, 0) for x, y in pts]
+    heel, toe = p[0], p[1]
+    n_down = len(pts) - 2 - (1 if s.water_level_m < s.dam_height_m else 0)  # toe..crest_d
+    lines = [geo.addLine(p[i], p[(i + 1) % len(p)]) for i in range(len(p))]
+    base = lines[0]
+    downstream = lines[1:n_down]
+    crest = lines[n_down]
+    upstream = lines[n_down + 1:]
+    s_dam = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+
+    f = [geo.addPoint(x, y, 0) for x, y in [(-Lu, -D), (B + Ld, -D), (B + Ld, 0), (-Lu, 0)]]
+    bottom, right = geo.addLine(f[0], f[1]), geo.addLine(f[1], f[2])
+    tail_bed, res_bed = geo.addLine(f[2], toe), geo.addLine(heel, f[3])
+    left = geo.addLine(f[3], f[0])
+    s_found = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, tail_bed, -base, res_bed,
+                                                     left])])
+    log_curves, s_log = _log_2d(s, geo)
+    geo.synchronize()
+
+    _gmsh.physical(2, [s_dam], DAM, NAMES[DAM])
+    _gmsh.physical(2, [s_found], FOUNDATION, NAMES[FOUNDATION])
+    _gmsh.physical(2, [s_log], LOG, NAMES[LOG])
+    groups = {FOUNDATION_BOTTOM: [bottom], FOUNDATION_SIDES: [left, right],
+              RESERVOIR_BED: [res_bed], TAILWATER_BED: [tail_bed], DAM_BASE: [base],
+              DAM_UPSTREAM: upstream, DAM_CREST: [crest], DAM_DOWNSTREAM: downstream,
+              **log_curves}
+    for tag, curves in groups.items():
+        _gmsh.physical(1, curves, tag, NAMES[tag])
+    _refine_near_log(s, [c for cs in log_curves.values() for c in cs], 1)
+    gmsh.model.mesh.generate(2)
+    return info
+
+
+def _log_2d(s, geo):
+    """The log's rectangle: corners back-lower, front-lower, front-upper, back-upper."""
+    a = s.log_axis
+    n = np.array([-a[1], a[0]])
+    c, hl, r = s.log_centre, 0.5 * s.log_length_m, s.log_radius_m
+    corners = [c - hl * a - r * n, c + hl * a - r * n, c + hl * a + r * n, c - hl * a + r * n]
+    q = [geo.addPoint(float(x), float(y), 0) for x, y in corners]
+    lower, front = geo.addLine(q[0], q[1]), geo.addLine(q[1], q[2])
+    upper, back = geo.addLine(q[2], q[3]), geo.addLine(q[3], q[0])
+    surface = geo.addPlaneSurface([geo.addCurveLoop([lower, front, upper, back])])
+    return ({LOG_LOWER: [lower], LOG_FRONT: [front], LOG_UPPER: [upper], LOG_BACK: [back]},
+            surface)
+
+
+def _model_3d(s, info):
+    import gmsh
+    occ = gmsh.model.occ
+    B, W, H = s.base_width_m, s.dam_width_m, s.dam_height_m
+    Lu, Ld, D = s.foundation_upstream_m, s.foundation_downstream_m, s.foundation_depth_m
+    # The profile in the x–z plane, swept along y: the water-line and tailwater points
+    # become edges splitting the faces.
+    p = [occ.addPoint(x, 0, z) for x, z in profile_points(s)]
+    loop = occ.addCurveLoop([occ.addLine(p[i], p[(i + 1) % len(p)]) for i in range(len(p))])
+    profile = occ.addPlaneSurface([loop])
+    dam_vol = [t for d, t in occ.extrude([(2, profile)], 0, W, 0) if d == 3]
+    found_box = occ.addBox(-Lu, 0, -D, B + Lu + Ld, W, D)
+    occ.fragment([(3, v) for v in dam_vol], [(3, found_box)])
+    log_vol = _log_3d(s, occ)
+    occ.synchronize()
+
+    dam = _gmsh.volumes_in(0, 0, 0, B, W, H)
+    found = _gmsh.volumes_in(-Lu, 0, -D, B + Ld, W, 0)
+    _gmsh.physical(3, dam, DAM, NAMES[DAM])
+    _gmsh.physical(3, found, FOUNDATION, NAMES[FOUNDATION])
+    _gmsh.physical(3, [log_vol], LOG, NAMES[LOG])
+    faces = _faces_3d(s, dam, found, log_vol)
+    for tag, fs in faces.items():
+        _gmsh.physical(2, fs, tag, NAMES[tag])
+    _refine_near_log(s, faces[LOG_MANTLE] + faces[LOG_FRONT] + faces[LOG_BACK], 2)
+    gmsh.model.mesh.generate(3)
+    return info
+
+
+def _log_3d(s, occ):
+    a, L = s.log_axis, s.log_length_m
+    back = s.log_centre - 0.5 * L * a
+    return occ.addCylinder(*map(float, back), *map(float, L * a), s.log_radius_m)
+
+
+def _faces_3d(s, dam, found, log_vol):
+    import gmsh
+    B, W, H = s.base_width_m, s.dam_width_m, s.dam_height_m
+    Lu, Ld, D = s.foundation_upstream_m, s.foundation_downstream_m, s.foundation_depth_m
+    fin = _gmsh.faces_in
+    out = {
+        FOUNDATION_BOTTOM: fin(-Lu, 0, -D, B + Ld, W, -D, found),
+        FOUNDATION_SIDES: fin(-Lu, 0, -D, -Lu, W, 0, found) + fin(B + Ld, 0, -D, B + Ld, W, 0,
+                                                                  found),
+        FOUNDATION_FLANKS: fin(-Lu, 0, -D, B + Ld, 0, 0, found) + fin(-Lu, W, -D, B + Ld, W, 0,
+                                                                      found),
+        RESERVOIR_BED: fin(-Lu, 0, 0, 0, W, 0, found),
+        TAILWATER_BED: fin(B, 0, 0, B + Ld, W, 0, found),
+        DAM_BASE: fin(0, 0, 0, B, W, 0, dam),
+        DAM_UPSTREAM: fin(0, 0, 0, 0, W, H, dam),
+        DAM_CREST: fin(0, 0, H, B, W, H, dam),
+        DAM_FLANKS: fin(0, 0, 0, B, 0, H, dam) + fin(0, W, 0, B, W, H, dam),
+    }
+    taken = {f for fs in out.values() for f in fs}
+    dam_faces = {abs(t) for _, t in gmsh.model.getBoundary([(3, v) for v in dam],
+                                                           oriented=False)}
+    out[DAM_DOWNSTREAM] = sorted(dam_faces - taken)
+    log_faces = [abs(t) for _, t in gmsh.model.getBoundary([(3, log_vol)], oriented=False)]
+    ends = {}
+    front = s.log_centre + 0.5 * s.log_length_m * s.log_axis
+    for f in log_faces:
+        com = np.array(gmsh.model.occ.getCenterOfMass(2, f))
+        ends[f] = np.linalg.norm(com - front)
+    flat = sorted(log_faces, key=lambda f: gmsh.model.getType(2, f) != "Plane")[:2]
+    out[LOG_FRONT] = [min(flat, key=ends.get)]
+    out[LOG_BACK] = [max(flat, key=ends.get)]
+    out[LOG_MANTLE] = sorted(set(log_faces) - set(flat))
+    return out
