@@ -25,7 +25,8 @@ def _sizes(h, h_far, refine):
     return h, max(hf, h)
 
 
-def build(comm, block=(0.1, 0.05), base=(0.3, 0.1), h=0.005, h_far=0.01, refine=0, gap=0.0):
+def build(comm, block=(0.1, 0.05), base=(0.3, 0.1), h=0.005, h_far=0.01, refine=0, gap=0.0,
+          patch=None, patch_spacing=None):
     """2D mesh on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -34,6 +35,11 @@ def build(comm, block=(0.1, 0.05), base=(0.3, 0.1), h=0.005, h_far=0.01, refine=
         h: element size on the interface (m); h_far: element size far from it (m).
         refine: each level halves h and h_far.
         gap: initial vertical gap between block and base (m, ≥ 0).
+        patch: (x0, x1), the extent of the base's master patch (m); default the block's
+            width under it. A longer patch is the candidate zone of a block that slides.
+        patch_spacing: the patch's node spacing relative to h, for non-matching meshes;
+            default None: the block's spacing (matching nodes when the patch is the
+            block's width).
 
     ``info``: block, base (tuples), block_width, block_height, base_width, base_depth, h (the
     actual interface spacing), h_far, gap, n_contact_nodes (per surface).
@@ -45,15 +51,24 @@ def build(comm, block=(0.1, 0.05), base=(0.3, 0.1), h=0.005, h_far=0.01, refine=
     gap = _nonneg_gap(gap)
     h, hf = _sizes(h, h_far, refine)
     n = max(1, math.ceil(bw / h - 1e-9))  # interface segments
+    x0, x1 = (-bw / 2, bw / 2) if patch is None else (float(patch[0]), float(patch[1]))
+    if not -Bw / 2 < x0 < x1 < Bw / 2 and patch is not None:
+        raise ValueError(f"patch={patch!r}: need -base_width/2 < x0 < x1 < base_width/2 "
+                         f"(base width {Bw!r})")
+    hp = h * (1.0 if patch_spacing is None else
+              _check.positive("patch_spacing", patch_spacing, "ratio"))
+    n_patch = n if patch is None and patch_spacing is None else \
+        max(1, math.ceil((x1 - x0) / hp - 1e-9))
     info = dict(block=(bw, bh), base=(Bw, Bd), block_width=bw, block_height=bh, base_width=Bw,
-                base_depth=Bd, h=bw / n, h_far=hf, gap=gap, n_contact_nodes=n + 1)
+                base_depth=Bd, h=bw / n, h_far=hf, gap=gap, n_contact_nodes=n + 1,
+                patch=(x0, x1), h_patch=(x1 - x0) / n_patch)
 
     def model():
         import gmsh
         geo = gmsh.model.geo
         # Base (master), counter-clockwise; the patch under the block is its own curve.
         p = [geo.addPoint(x, y, 0) for x, y in
-             [(-Bw / 2, -Bd), (Bw / 2, -Bd), (Bw / 2, 0), (bw / 2, 0), (-bw / 2, 0), (-Bw / 2, 0)]]
+             [(-Bw / 2, -Bd), (Bw / 2, -Bd), (Bw / 2, 0), (x1, 0), (x0, 0), (-Bw / 2, 0)]]
         bottom, right = geo.addLine(p[0], p[1]), geo.addLine(p[1], p[2])
         top_r, patch = geo.addLine(p[2], p[3]), geo.addLine(p[4], p[3])  # patch: left -> right
         top_l, left = geo.addLine(p[4], p[5]), geo.addLine(p[5], p[0])
@@ -65,8 +80,8 @@ def build(comm, block=(0.1, 0.05), base=(0.3, 0.1), h=0.005, h_far=0.01, refine=
         b_bot, b_right = geo.addLine(q[0], q[1]), geo.addLine(q[1], q[2])
         b_top, b_left = geo.addLine(q[2], q[3]), geo.addLine(q[3], q[0])
         s_block = geo.addPlaneSurface([geo.addCurveLoop([b_bot, b_right, b_top, b_left])])
-        for c in (patch, b_bot):
-            geo.mesh.setTransfiniteCurve(c, n + 1)
+        geo.mesh.setTransfiniteCurve(patch, n_patch + 1)
+        geo.mesh.setTransfiniteCurve(b_bot, n + 1)
         geo.synchronize()
 
         _gmsh.physical(2, [s_base], BASE, NAMES[BASE])

@@ -32,7 +32,8 @@ def gap(x, R):
 
 
 def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
-          zone_factor=2.5, block_width=None, block_depth=None):
+          zone_factor=2.5, block_width=None, block_depth=None, block_spacing=None,
+          with_cylinder=True):
     """Build the mesh on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -43,6 +44,11 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         refine: each level halves h_contact and h_far (≈ 4× the cells).
         zone_factor: candidate zone half-width w = zone_factor · a_expected (≥ 1).
         block_width, block_depth: block size W × D (m); default 8R × 4R.
+        block_spacing: the block's zone spacing relative to the cylinder's, for
+            non-matching meshes (e.g. 0.7); default None: the same abscissae (matching
+            nodes, each slave node above its master node).
+        with_cylinder: False builds the block alone (for a rigid circle as the target; no
+            UPPER, LOADED or SLAVE tags).
 
     ``info`` holds R, a_expected, w, h_contact (the actual zone spacing), h_far,
     block_width, block_depth and n_contact_nodes (per surface).
@@ -62,8 +68,14 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
 
     n = math.ceil(w / h - 1e-9)          # segments per side of x = 0
     xs = [w * i / n for i in range(-n, n + 1)]  # symmetric; x = 0 is a node of both bodies
+    if block_spacing is None:
+        xb = xs
+    else:
+        nb = math.ceil(w / (_check.positive("block_spacing", block_spacing, "ratio") * h) - 1e-9)
+        xb = [w * i / nb for i in range(-nb, nb + 1)]
     info = dict(R=R, a_expected=a, w=w, h_contact=w / n, h_far=hf, block_width=W,
-                block_depth=D, n_contact_nodes=2 * n + 1)
+                block_depth=D, n_contact_nodes=2 * n + 1, h_block=w * 2 / (len(xb) - 1),
+                n_block_nodes=len(xb))
 
     def model():
         import gmsh
@@ -71,13 +83,28 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         # Block (master): counter-clockwise boundary.
         bl, br = geo.addPoint(-W / 2, -D, 0), geo.addPoint(W / 2, -D, 0)
         tr, tl = geo.addPoint(W / 2, 0, 0), geo.addPoint(-W / 2, 0, 0)
-        pm = [geo.addPoint(x, 0, 0) for x in xs]
-        seg_m = [geo.addLine(pm[i], pm[i + 1]) for i in range(2 * n)]  # left -> right
+        pm = [geo.addPoint(x, 0, 0) for x in xb]
+        seg_m = [geo.addLine(pm[i], pm[i + 1]) for i in range(len(xb) - 1)]  # left -> right
         bottom, right = geo.addLine(bl, br), geo.addLine(br, tr)
         top_r, top_l, left = geo.addLine(tr, pm[-1]), geo.addLine(pm[0], tl), geo.addLine(tl, bl)
         loop_m = geo.addCurveLoop([bottom, right, top_r] + [-s for s in reversed(seg_m)]
                                   + [top_l, left])
         block = geo.addPlaneSurface([loop_m])
+        for s in seg_m:
+            geo.mesh.setTransfiniteCurve(s, 2)  # one element per segment: nodes = points
+
+        def block_groups():
+            _gmsh.physical(2, [block], BASE, NAMES[BASE])
+            _gmsh.physical(1, [bottom], FIXED, NAMES[FIXED])
+            _gmsh.physical(1, seg_m, MASTER, NAMES[MASTER])
+
+        if not with_cylinder:
+            geo.synchronize()
+            block_groups()
+            near = 0.25 * w
+            _gmsh.size_field(seg_m, 1, h, hf, near, near + 3 * (hf - h), points_per_curve=4)
+            gmsh.model.mesh.generate(2)
+            return info
         # Cylinder (slave): nodes of the zone exactly above the block's.
         c = geo.addPoint(0, R, 0)
         ps = [geo.addPoint(x, float(gap(x, R)), 0) for x in xs]
@@ -86,15 +113,13 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         arc_r, top = geo.addCircleArc(ps[-1], c, ar), geo.addLine(ar, al)
         arc_l = geo.addCircleArc(al, c, ps[0])
         cyl = geo.addPlaneSurface([geo.addCurveLoop(seg_s + [arc_r, top, arc_l])])
-        for s in seg_m + seg_s:
-            geo.mesh.setTransfiniteCurve(s, 2)  # one element per segment: nodes = points
+        for s in seg_s:
+            geo.mesh.setTransfiniteCurve(s, 2)
         geo.synchronize()
 
-        _gmsh.physical(2, [block], BASE, NAMES[BASE])
+        block_groups()
         _gmsh.physical(2, [cyl], UPPER, NAMES[UPPER])
-        _gmsh.physical(1, [bottom], FIXED, NAMES[FIXED])
         _gmsh.physical(1, [top], LOADED, NAMES[LOADED])
-        _gmsh.physical(1, seg_m, MASTER, NAMES[MASTER])
         _gmsh.physical(1, seg_s, SLAVE, NAMES[SLAVE])
 
         near = 0.25 * w

@@ -34,7 +34,8 @@ def gap(x, y, R):
 
 
 def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
-          zone_factor=2.5, column_radius=None, column_height=None, block=None):
+          zone_factor=2.5, column_radius=None, column_height=None, block=None,
+          with_block=True):
     """Build the quarter model on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -47,6 +48,8 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         column_radius: Rc, with w < Rc < R (m); default R/2.
         column_height: H, height of the column's top above the contact point (m); default R.
         block: (Lx, Ly, D) of the quarter block (m); default (4R, 4R, 4R).
+        with_block: False builds the column alone (for a rigid plane z = 0 as the target;
+            no BASE, FIXED or MASTER tags).
 
     ``info`` holds R, a_expected, w, h_contact, h_far, column_radius, column_height, block
     and n_contact_nodes (per surface).
@@ -76,30 +79,32 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
     def model():
         import gmsh
         occ = gmsh.model.occ
-        base_box = occ.addBox(0, 0, -D, Lx, Ly, D)
-        occ.fragment([(3, base_box)], [(2, _quarter_disc(occ, w, 0.0))])
+        if with_block:
+            base_box = occ.addBox(0, 0, -D, Lx, Ly, D)
+            occ.fragment([(3, base_box)], [(2, _quarter_disc(occ, w, 0.0))])
         col = occ.addCylinder(0, 0, z0, 0, 0, H, Rc, angle=math.pi / 2)
         occ.fragment([(3, col)], [(2, _quarter_disc(occ, w, z0))])
         occ.synchronize()
 
-        base_vol = _gmsh.volumes_in(0, 0, -D, Lx, Ly, 0)
+        base_vol = _gmsh.volumes_in(0, 0, -D, Lx, Ly, 0) if with_block else []
         col_vol = _gmsh.volumes_in(0, 0, z0, Rc, Rc, z0 + H)
         both = base_vol + col_vol
-        patch_m = _gmsh.faces_in(0, 0, 0, w, w, 0, base_vol)
+        patch_m = _gmsh.faces_in(0, 0, 0, w, w, 0, base_vol) if with_block else []
         patch_s = _gmsh.faces_in(0, 0, z0, w, w, z0, col_vol)
-        gmsh.model.mesh.setPeriodic(2, patch_s, patch_m,
-                                    [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, z0, 0, 0, 0, 1])
-
-        _gmsh.physical(3, base_vol, BASE, NAMES[BASE])
+        if with_block:
+            gmsh.model.mesh.setPeriodic(2, patch_s, patch_m,
+                                        [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, z0, 0, 0, 0, 1])
+            _gmsh.physical(3, base_vol, BASE, NAMES[BASE])
+            _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, Lx, Ly, -D, base_vol), FIXED,
+                           NAMES[FIXED])
+            _gmsh.physical(2, patch_m, MASTER, NAMES[MASTER])
         _gmsh.physical(3, col_vol, UPPER, NAMES[UPPER])
-        _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, Lx, Ly, -D, base_vol), FIXED, NAMES[FIXED])
         _gmsh.physical(2, _gmsh.faces_in(0, 0, z0 + H, Rc, Rc, z0 + H, col_vol), LOADED,
                        NAMES[LOADED])
         _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, 0, max(Ly, Rc), z0 + H, both),
                        SYMMETRY_X, NAMES[SYMMETRY_X])
         _gmsh.physical(2, _gmsh.faces_in(0, 0, -D, max(Lx, Rc), 0, z0 + H, both),
                        SYMMETRY_Y, NAMES[SYMMETRY_Y])
-        _gmsh.physical(2, patch_m, MASTER, NAMES[MASTER])
         _gmsh.physical(2, patch_s, SLAVE, NAMES[SLAVE])
         # The column is slender: cap its size so that its rim and loaded top are resolved.
         cap = (max(h, Rc / 4), -Rc, -Rc, z0 - Rc, 2 * Rc, 2 * Rc, z0 + H + Rc)
@@ -107,7 +112,7 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
                          boxes=[cap])
         gmsh.model.mesh.generate(3)
         info["n_contact_nodes"] = len(set().union(*(
-            gmsh.model.mesh.getNodes(2, f, includeBoundary=True)[0] for f in patch_m)))
+            gmsh.model.mesh.getNodes(2, f, includeBoundary=True)[0] for f in patch_s)))
         return info
 
     msh, cell_tags, facet_tags, info = _gmsh.generate(comm, "hertz3d", model, gdim=3)

@@ -9,7 +9,7 @@ import numpy as np
 from conftest import ROOT, mpirun
 
 
-def run_demo(name, *args, results, ranks=1, timeout=900):
+def run_demo(name, *args, results, ranks=1, timeout=900, subfolder=""):
     env = {"FLEXCONTACT_RESULTS": str(results)}
     script = ROOT / "demos" / f"{name}.py"
     if ranks == 1:
@@ -25,7 +25,7 @@ def run_demo(name, *args, results, ranks=1, timeout=900):
             mpirun(ranks, script, *args, env=env, timeout=timeout)
         except subprocess.CalledProcessError as e:
             raise AssertionError(f"{name} failed on {ranks} ranks:\n{e.stdout[-3000:]}\n{e.stderr[-3000:]}")
-    folder = Path(results) / name
+    folder = Path(results) / name / subfolder
     return json.loads((folder / "summary.json").read_text()), folder
 
 

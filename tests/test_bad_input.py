@@ -2,6 +2,7 @@
 import math
 import xml.etree.ElementTree as ET
 
+import numpy as np
 import pytest
 import ufl
 from mpi4py import MPI
@@ -109,3 +110,41 @@ def test_held_pairs_pushed_together_are_named(setup):
     with pytest.raises(fc.ConvergenceError, match=r"increment 1: .*held by Dirichlet.*penetrates by 1.000e-06 m"):
         problem.step()
     assert problem.increments == []
+
+
+def test_free_body_names_each_mode_once(setup):
+    msh, cells, facets, V, a, geo = setup
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    with pytest.raises(ValueError) as free:
+        _problem(setup, bcs=fixed)               # nothing holds the block
+    msg = str(free.value)
+    for mode in ("translation along x", "translation along y", "rotation about z"):
+        assert msg.count(mode) == 1, msg
+    # The top held along x only: the block can move up and down and turn about a point of
+    # its top line (a rotation plus a translation along x): both are named, x is not.
+    top_x, _ = fc.dirichlet(V, facets, tags.LOADED, components=[0])
+    with pytest.raises(ValueError) as turning:
+        _problem(setup, bcs=fixed + top_x)
+    msg = str(turning.value)
+    assert "translation along y" in msg and "rotation about z" in msg, msg
+    assert "translation along x" not in msg, msg
+
+
+def test_missing_material_is_not_a_missing_support(setup):
+    msh, cells, facets, V, a, geo = setup
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
+    base_only = forms.elasticity_form(u, v, {tags.BASE: STEEL}, dx, "plane_strain")
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    top, _ = fc.dirichlet(V, facets, tags.LOADED)
+    with pytest.raises(ValueError, match=r"body 'block'.*no material") as e:
+        fc.ContactProblem(base_only, None, fixed + top,
+                          fc.ContactInterface(facets, tags.SLAVE, tags.MASTER, 0.3),
+                          bodies=(cells, {"base": tags.BASE, "block": tags.UPPER}))
+    assert "Dirichlet" not in str(e.value).split("body 'block'")[1]
+
+
+@pytest.mark.parametrize("mu", [np.float32(0.3), np.array(0.3)])
+def test_numpy_friction_coefficient_accepted(setup, mu):
+    itf = fc.ContactInterface(setup[2], tags.SLAVE, tags.MASTER, mu)
+    assert isinstance(itf.mu, float) and itf.mu == pytest.approx(0.3, rel=1e-7)

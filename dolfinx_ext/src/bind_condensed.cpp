@@ -87,11 +87,15 @@ std::vector<bool> flags(const std::optional<BoolArray>& a)
 }
 
 /// @brief Node–node or node–segment pairs with frames from the masters' normals, built in
-/// one call: slave (m), masters (m × j), weights (m × j), normals (m × d).
+/// one call: slave (m), masters (m × j), weights (m × j), normals (m × d), offsets (m or none).
 std::vector<ContactPair> pairs_from_normals(const IntArray& slave, const IntArray& masters,
-                                            const RealArray& weights, const RealArray& normals)
+                                            const RealArray& weights, const RealArray& normals,
+                                            const std::optional<RealArray>& offsets)
 {
   const py::ssize_t m = slave.size();
+  if (offsets and offsets->size() != m)
+    throw std::invalid_argument("offsets has " + std::to_string(offsets->size())
+                                + " entries but there are " + std::to_string(m) + " pairs");
   if (masters.ndim() != 2 or weights.ndim() != 2 or normals.ndim() != 2)
     throw std::invalid_argument("masters, weights and normals must be 2-D arrays");
   if (masters.shape(0) != m or weights.shape(0) != m or normals.shape(0) != m)
@@ -109,6 +113,8 @@ std::vector<ContactPair> pairs_from_normals(const IntArray& slave, const IntArra
     p.masters.assign(masters.data() + k * j, masters.data() + (k + 1) * j);
     p.weights.assign(weights.data() + k * j, weights.data() + (k + 1) * j);
     p.frame = frame_from_normal(Eigen::Map<const Vector>(normals.data() + k * d, d));
+    if (offsets)
+      p.offset = offsets->data()[k];
   }
   return pairs;
 }
@@ -120,9 +126,10 @@ void flexcontact::bind_condensed(py::module& m)
   const py::handle convergence_error = m.attr("ConvergenceError");
 
   m.def("pairs_from_normals", &pairs_from_normals, py::arg("slave"), py::arg("masters"),
-        py::arg("weights"), py::arg("normals"),
+        py::arg("weights"), py::arg("normals"), py::arg("offsets") = py::none(),
         "ContactPairs with frames from the masters' outward normals, in one call: slave (m), "
-        "masters (m x j), weights (m x j), normals (m x d)");
+        "masters (m x j), weights (m x j), normals (m x d), offsets (m, normal distance of the "
+        "master surface from the master point [m]; None: 0)");
 
   py::class_<CondensedContact>(
       m, "CondensedContact",

@@ -218,7 +218,9 @@ void flexcontact::bind_kernel(py::module& m)
       .def_readwrite("slave", &ContactPair::slave)
       .def_readwrite("masters", &ContactPair::masters)
       .def_readwrite("weights", &ContactPair::weights)
-      .def_readwrite("frame", &ContactPair::frame);
+      .def_readwrite("frame", &ContactPair::frame)
+      .def_readwrite("offset", &ContactPair::offset,
+                     "Normal distance of the master surface from the master point [m]");
 
   m.def(
       "frame_from_normal", [](const Vector& n) { return frame_from_normal(n); }, py::arg("n"),

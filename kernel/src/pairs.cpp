@@ -38,6 +38,8 @@ void check_pair(const ContactPair& c, int k, int dim, int n_nodes)
                                 + std::to_string(dim) + "x" + std::to_string(dim));
   if (!c.frame.allFinite())
     throw std::invalid_argument(which + ": frame is not finite");
+  if (!std::isfinite(c.offset))
+    throw std::invalid_argument(which + ": offset is not finite");
 }
 } // namespace
 
@@ -128,6 +130,7 @@ Vector initial_gap(const std::vector<ContactPair>& pairs, const Eigen::Ref<const
     for (std::size_t j = 0; j < c.masters.size(); ++j)
       d -= c.weights[j] * X.row(c.masters[j]).transpose();
     x0.segment(k * dim, dim) = c.frame * d;
+    x0[k * dim] -= c.offset;
   }
   return x0;
 }

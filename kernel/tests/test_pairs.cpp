@@ -116,6 +116,21 @@ TEST(InitialGap, SlaveAboveSegment)
   EXPECT_LT((Matrix(gap_operator(2, 3, pairs)) * Xs - x0).norm(), 1e-15);
 }
 
+TEST(InitialGap, OffsetOfARigidCircle)
+{
+  // Slave at (3, 4) against a circle of radius 2 centred at the origin (node 0): the radial
+  // normal (0.6, 0.8) gives the normal gap |X_s| − R = 5 − 2 = 3 and no tangential gap.
+  Matrix X(2, 2);
+  X << 0.0, 0.0, 3.0, 4.0;
+  auto pair = make_pair(1, {0}, {1.0}, vec({0.6, 0.8}));
+  pair.offset = 2.0;
+  const Vector x0 = initial_gap({pair}, X);
+  EXPECT_NEAR(x0[0], 3.0, 1e-14);
+  EXPECT_NEAR(x0[1], 0.0, 1e-14);
+  pair.offset = std::nan("");
+  EXPECT_THROW(initial_gap({pair}, X), std::invalid_argument);
+}
+
 TEST(Delassus, RigidTargetRotatesFlexibilityIntoFrame)
 {
   // One node against a rigid wall with normal (0, 1): W = T F Tᵀ swaps the axes.

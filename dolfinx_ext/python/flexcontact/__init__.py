@@ -16,7 +16,9 @@ from ._cpp import (ConvergenceError, MumpsError, PetscError, SingularStiffnessEr
 from .boundary import dirichlet, hold_body
 from .names import FLEXIBILITY_METHODS, SOLVER_NAMES, FlexibilityMethod, SolverName
 from .output import ResultWriter, results_folder, write_summary
-from .problem import ContactInterface, ContactProblem, IncrementSummary
+from .problem import (ContactInterface, ContactProblem, ContactZoneError, ContactZoneWarning,
+                      IncrementSummary)
+from .rigid import RigidTarget
 from .dynamics import ImpactProblem, ImpactStepRecord
 
 __version__ = "0.1.0"
@@ -24,6 +26,7 @@ __version__ = "0.1.0"
 __all__ = [
     "ContactInterface", "ContactProblem", "IncrementSummary", "SolverOptions",
     "ImpactProblem", "ImpactStepRecord",
+    "RigidTarget", "ContactZoneWarning", "ContactZoneError",
     "dirichlet", "hold_body", "ResultWriter", "results_folder", "write_summary",
     "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",

@@ -17,6 +17,13 @@ from . import _cpp, compat
 from .pairing import NodePairs
 
 
+def kernel_pairs(pairs) -> list:
+    """The kernel's ContactPairs of NodePairs or SurfacePairs (rank 0)."""
+    m = pairs.m
+    return _cpp.pairs_from_normals(np.arange(m), pairs.masters, pairs.weights, pairs.normal,
+                                   pairs.offset)
+
+
 class Condensation:
     """F*, its factor and the condensed contact problem of fixed pairs.
 
@@ -25,7 +32,8 @@ class Condensation:
     K : assembled stiffness (Dirichlet rows are identity rows).
     bcs : the Dirichlet conditions; contact DOFs they hold get no flexibility and no
         contact reaction.
-    pairs, mu : the node pairs and their friction coefficients (rank 0; None elsewhere).
+    pairs, mu : the pairs (NodePairs or SurfacePairs) and their friction coefficients
+        (rank 0; None elsewhere).
     dim : 2 or 3.
     options : kernel SolverOptions.
     method : how F* is computed (see ``_cpp.flexibility``).
@@ -42,8 +50,12 @@ class Condensation:
                  kernel: Optional[Callable] = None):
         self.comm = comm
         root = comm.rank == 0
-        self.dofs = (pairs.dofs.reshape(-1).astype(np.int64) if root
-                     else np.zeros(0, np.int64))
+        self.pairs = pairs
+        # Rigid targets' reference nodes (last) have no PETSc DOFs: held, zero flexibility.
+        n_virtual = getattr(pairs, "n_virtual", 0) if root else 0
+        real = pairs.dofs[:pairs.dofs.shape[0] - n_virtual] if root else None
+        self.dofs = (real.reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
+        self.n_virtual_dofs = n_virtual * dim
         is_from = PETSc.IS().createGeneral(self.dofs.astype(PETSc.IntType), comm=comm)
         self._seq = PETSc.Vec().createSeq(self.dofs.size, comm=PETSc.COMM_SELF)
         is_to = PETSc.IS().createStride(self.dofs.size, 0, 1, comm=PETSc.COMM_SELF)
@@ -56,20 +68,38 @@ class Condensation:
         F, self.factor, info = _cpp.flexibility(K, self.dofs, method)
         self.timings["flexibility_s"] = time.perf_counter() - t0
         self.flex_info = dict(info)
+        self.factorizations = 1
         self.n_contact_dofs = comm.bcast(self.dofs.size if root else None, root=0)
 
         self.contact = self.B = self.W = self.x0 = self.frames = None
         if root:
-            m = pairs.m
-            # Node k < m is the slave of pair k, node m + k its master (NodePairs' numbering).
-            kpairs = _cpp.pairs_from_normals(np.arange(m), np.arange(m, 2 * m)[:, None],
-                                             np.ones((m, 1)), pairs.normal)
+            nv = self.n_virtual_dofs
+            if nv:
+                F = np.pad(np.asarray(F), ((0, nv), (0, nv)))
+                constrained = np.concatenate([constrained, np.ones(nv, bool)])
             t0 = time.perf_counter()
             build = kernel if kernel is not None else _cpp.CondensedContact
-            self.contact = build(dim, F, pairs.x, kpairs, mu, constrained, options)
+            self.contact = build(dim, F, pairs.x, kernel_pairs(pairs), mu, constrained, options)
             self.timings["delassus_s"] = time.perf_counter() - t0
-            c = self.contact
-            self.B, self.W, self.x0, self.frames = c.B, c.W, c.x0, c.frames
+            self._operators()
+
+    def _operators(self):
+        c = self.contact
+        self.B, self.W, self.x0, self.frames = c.B, c.W, c.x0, c.frames
+
+    def set_pairs(self, pairs, mu: np.ndarray) -> None:
+        """New pairs on the same contact nodes (rank 0): B, x0, W rebuilt from the stored F*,
+        no factorization."""
+        self.pairs = pairs
+        self.contact.set_pairs(kernel_pairs(pairs), mu)
+        self._operators()
+
+    def contact_values(self, up_c: np.ndarray) -> np.ndarray:
+        """The values of all contact DOFs (rank 0): the gathered ``up_c`` of the real ones,
+        then the rigid targets' prescribed translations."""
+        if not self.n_virtual_dofs:
+            return up_c
+        return np.concatenate([up_c, self.pairs.virtual_displacement()])
 
     def _constrained_mask(self, K: PETSc.Mat, bcs: Sequence) -> Optional[np.ndarray]:
         """True for the contact DOFs that a Dirichlet condition fixes (rank 0)."""
@@ -91,6 +121,7 @@ class Condensation:
         r = self._template.createVecLeft()
         r.zeroEntries()
         if self.comm.rank == 0:
-            r.setValues(self.dofs.astype(PETSc.IntType), r_c, addv=PETSc.InsertMode.ADD_VALUES)
+            r.setValues(self.dofs.astype(PETSc.IntType), r_c[:self.dofs.size],
+                        addv=PETSc.InsertMode.ADD_VALUES)
         r.assemble()
         return r

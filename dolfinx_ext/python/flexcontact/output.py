@@ -151,6 +151,9 @@ def run_record(problem, summaries, t_start: float, **timings_s) -> dict:
                       "increments": [s.time_s for s in summaries],
                       "total": time.perf_counter() - t_start},
         "increments": increments_table(summaries),
+        # One factorization serves every increment; pairs re-made without refactorizing.
+        "factorizations": int(getattr(problem, "factorizations", 1)),
+        "pairings": int(getattr(problem, "pairings", 1)),
     }
 
 

@@ -15,7 +15,9 @@ import numpy as np
 
 from . import compat
 from .surface import surface_nodes
+from .surface_pairs import build_surface_pairs, slave_edge_flags
 from .mpi import raise_on_every_rank
+from .zone import open_edge_flags
 
 
 @dataclass
@@ -31,6 +33,8 @@ class NodePairs:
     normal: np.ndarray     # (m, d) master outward unit normal per pair
     area: np.ndarray       # (m,) slave tributary length [m] (2D) or area [m²] (3D)
     area_master: np.ndarray  # (m,) master tributary measure
+    at_edge: Optional[np.ndarray] = None  # (m,) slave node on an open edge (zone.py)
+    interface: Optional[np.ndarray] = None  # (m,) index of each pair's interface
 
     @property
     def m(self) -> int:
@@ -39,6 +43,25 @@ class NodePairs:
     @property
     def dim(self) -> int:
         return self.normal.shape[1]
+
+    # The SurfacePairs view of node–node pairs (master of pair k is contact node m + k).
+    @property
+    def masters(self) -> np.ndarray:
+        return np.arange(self.m, 2 * self.m)[:, None]
+
+    @property
+    def weights(self) -> np.ndarray:
+        return np.ones((self.m, 1))
+
+    @property
+    def offset(self) -> np.ndarray:
+        return np.zeros(self.m)
+
+    @property
+    def node_area(self) -> np.ndarray:
+        return np.concatenate([self.area, self.area_master])
+
+    n_virtual = 0
 
 
 def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") -> NodePairs:
@@ -70,10 +93,8 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
         offset[start:start + chunk] = dt[np.arange(best.size), best]
     worst = int(np.argmax(offset))
     if offset[worst] > tolerance:
-        raise ValueError(
-            f"node–node contact{where}: slave node at {xs[worst].tolist()} has no master node "
-            f"within the tangential tolerance {tolerance:g} m (nearest is {offset[worst]:.3g} m "
-            f"away); the contact surfaces have no matching nodes")
+        raise ValueError(_unmatched_message(xs, np.asarray(slave["normal"]), xm, offset, worst,
+                                            tolerance, where))
     taken, counts = np.unique(partner, return_counts=True)
     if np.any(counts > 1):
         dup = int(taken[np.argmax(counts)])
@@ -86,39 +107,94 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
         normal=normals[partner],
         area=np.asarray(slave["area"], dtype=float),
         area_master=np.asarray(master["area"], dtype=float)[partner],
+        at_edge=slave_edge_flags(slave, xs.shape[1]) if "facets" in slave else None,
     )
 
 
-def pair_interfaces(V, interfaces: Sequence, comm) -> tuple[Optional[NodePairs], np.ndarray, int]:
+def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> str:
+    """Why node–node pairing failed: nodes that face each other one to one along the
+    slave's normals but not along the master's (a curved or tilted master), or nodes that
+    do not match at all."""
+    partner, off = [], []
+    for x, n in zip(xs, ns):
+        d = xm - x
+        t = np.sqrt(np.maximum(np.einsum("mk,mk->m", d, d) - (d @ n) ** 2, 0.0))
+        partner.append(int(np.argmin(t)))
+        off.append(float(t[partner[-1]]))
+    facing = (xs.shape[0] == xm.shape[0] and max(off) <= tolerance
+              and np.unique(partner).size == len(partner))
+    head = (f"node–node contact{where}: slave node at {xs[worst].tolist()} has no master "
+            f"node along the master surface's normal within the tangential tolerance "
+            f"{tolerance:g} m (the nearest is {offset[worst]:.3g} m off that line)")
+    if facing:
+        return (head + "; the two surfaces' nodes do face each other one to one, but along "
+                "the slave's normals, not the master's, as on a curved master surface. Use "
+                "pairing='node_to_surface' (any choice of slave and master), or make the "
+                "flat surface the master")
+    return (head + "; the contact surfaces have no matching nodes. Use "
+            "pairing='node_to_surface' for non-matching meshes")
+
+
+PAIRINGS = ("node_to_node", "node_to_surface")
+
+
+def pair_interfaces(V, interfaces: Sequence, comm):
     """Pairs of all contact interfaces in one node-major numbering.
 
-    Each interface gives ``facet_tags``, ``slave``, ``master``, ``mu``, ``tolerance_m`` (None:
-    1e-6 of the surfaces' extent) and ``label``. Returns (pairs, μ per pair) on rank 0,
-    (None, empty) elsewhere, and the pair count m on every rank. A pairing error is raised
-    as ValueError on every rank.
+    Each interface gives ``facet_tags``, ``slave``, ``master`` (a tag, or a RigidTarget),
+    ``mu``, ``tolerance_m`` (None: 1e-6 of the surfaces' extent), ``label`` and optionally
+    ``pairing`` ("node_to_node", the default, or "node_to_surface"). Returns (pairs, μ per
+    pair) on rank 0, (None, empty) elsewhere, and the pair count m on every rank. The pairs
+    are NodePairs when every interface is node–node between tagged surfaces, SurfacePairs
+    (surface_pairs.py) otherwise. A pairing error is raised as ValueError on every rank.
     """
     msh = V.mesh
     compat.create_connectivity(msh, msh.topology.dim - 1, msh.topology.dim)
     root = comm.rank == 0
     parts, mus, error = [], [], None
     for itf in interfaces:
+        rigid = not isinstance(itf.master, (int, np.integer))
+        kind = "rigid" if rigid else getattr(itf, "pairing", "node_to_node")
         # Collective: every rank takes part even after an error on rank 0.
-        s = surface_nodes(V, itf.facet_tags, itf.slave)
-        m = surface_nodes(V, itf.facet_tags, itf.master)
+        s = _candidate_surface(V, itf.facet_tags, itf.slave)
+        m = itf.master if rigid else _candidate_surface(V, itf.facet_tags, itf.master)
         if root and error is None:
             try:
-                tol = itf.tolerance_m
-                if tol is None:
-                    pts = np.vstack([s["x"], m["x"]])
-                    tol = 1e-6 * max(float(np.ptp(pts, axis=0).max()), 1e-300)
-                parts.append(match_nodes(s, m, tol, itf.label))
-                mus.append(np.full(parts[-1].m, float(itf.mu)))
+                parts.append((kind, s, _node_pairs(s, m, itf) if kind == "node_to_node"
+                              else m))
+                mus.append(np.full(np.asarray(s["x"]).shape[0], float(itf.mu)))
             except ValueError as e:
                 error = str(e)
+    if root and error is None and any(k != "node_to_node" for k, _, _ in parts):
+        try:
+            pairs = build_surface_pairs(parts, V.mesh.geometry.dim)
+        except ValueError as e:
+            error = str(e)
+    elif root and error is None:
+        pairs = concat([p for _, _, p in parts])
+        pairs.interface = np.concatenate([np.full(p.m, i) for i, (_, _, p) in
+                                          enumerate(parts)])
     raise_on_every_rank(comm, error)
-    pairs = concat(parts) if root else None
+    pairs = pairs if root else None
     mu = np.concatenate(mus) if root else np.zeros(0)
     return pairs, mu, comm.bcast(pairs.m if root else None, root=0)
+
+
+def _candidate_surface(V, facet_tags, value: int) -> dict:
+    """surface_nodes with the open-edge flags of the candidate-zone guard. Collective."""
+    s = surface_nodes(V, facet_tags, value)
+    flags = open_edge_flags(V, facet_tags, value, s)
+    if V.mesh.comm.rank == 0:
+        s["open_edge"] = flags
+    return s
+
+
+def _node_pairs(s: dict, m: dict, itf) -> NodePairs:
+    tol = itf.tolerance_m
+    if tol is None:
+        pts = np.vstack([s["x"], m["x"]])
+        tol = 1e-6 * max(float(np.ptp(pts, axis=0).max()), 1e-300)
+    return match_nodes(s, m, tol, itf.label)
 
 
 def concat(parts: list[NodePairs]) -> NodePairs:
@@ -132,4 +208,6 @@ def concat(parts: list[NodePairs]) -> NodePairs:
         normal=np.vstack([p.normal for p in parts]),
         area=np.concatenate([p.area for p in parts]),
         area_master=np.concatenate([p.area_master for p in parts]),
+        at_edge=(np.concatenate([p.at_edge for p in parts])
+                 if all(p.at_edge is not None for p in parts) else None),
     )

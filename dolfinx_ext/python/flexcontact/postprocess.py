@@ -6,7 +6,7 @@ the method's algebra is redone in NumPy.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Optional
 
 import numpy as np
@@ -42,6 +42,8 @@ class IncrementSummary:
     state_changes: int
     solver: str
     time_s: float
+    zone_edge: list = field(default_factory=list)  # interfaces whose contact reached an
+    #                                                open edge of a candidate surface
 
     def line(self) -> str:
         t = np.linalg.norm(self.tangential_force)
@@ -93,6 +95,28 @@ def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
     return IncrementResult(summary, e, e, np.zeros(0, int), e[:, 1:], e)
 
 
+def _nodal_contact(inc: IncrementResult, pairs):
+    """Pressure, tangential traction (global axes) and status (1 open, 2 stick, 3 slip) at
+    every contact node: a slave node carries its pair's force over its tributary measure,
+    a master node the equal and opposite forces Σ_k w_kj (…) of the pairs that use it."""
+    m, n = pairs.m, pairs.x.shape[0]
+    masters, weights = pairs.masters, pairs.weights
+    force_n = np.zeros(n)
+    force_t = np.zeros((n, pairs.x.shape[1]))
+    state = np.zeros(n)
+    force_n[:m] += inc.lam[:, 0]
+    force_t[:m] += inc.tangential
+    state[:m] = inc.states
+    for j in range(masters.shape[1]):
+        w = weights[:, j]
+        np.add.at(force_n, masters[:, j], w * inc.lam[:, 0])
+        np.add.at(force_t, masters[:, j], -w[:, None] * inc.tangential)
+        used = w > 0
+        np.maximum.at(state, masters[used, j], inc.states[used].astype(float))
+    area = np.where(pairs.node_area > 0, pairs.node_area, np.inf)
+    return force_n / area, force_t / area[:, None], state + 1.0
+
+
 class ContactFields:
     """The output Functions: displacement, contact pressure, tangential traction, status
     (1 open, 2 stick, 3 slip) and, if ``stress`` is given (u -> UFL scalar), a DG0 stress."""
@@ -123,15 +147,11 @@ class ContactFields:
         """Contact fields of an increment at the slave and master nodes (collective)."""
         d = self.dim
         if self.comm.rank == 0:
-            blocks = pairs.dofs[:, :1] // d
-            area = np.concatenate([pairs.area, pairs.area_master])
-            lam_n = np.concatenate([inc.lam[:, 0], inc.lam[:, 0]])
-            pressure = (lam_n / area)[:, None]
-            t = inc.tangential
-            # Master nodes carry the reaction: equal and opposite traction.
-            trac = np.vstack([t / pairs.area[:, None], -t / pairs.area_master[:, None]])
-            status = np.concatenate([inc.states, inc.states])[:, None] + 1.0
-            dofs_v = pairs.dofs
+            pressure, trac, status = _nodal_contact(inc, pairs)
+            real = pairs.dofs[:, 0] >= 0          # rigid targets' reference nodes: no DOFs
+            dofs_v = pairs.dofs[real]
+            blocks = dofs_v[:, :1] // d
+            pressure, trac, status = pressure[real, None], trac[real], status[real, None]
         else:
             blocks = np.zeros((0, 1), np.int64)
             pressure = status = np.zeros((0, 1))

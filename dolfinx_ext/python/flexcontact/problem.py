@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Optional, Sequence, Union
 
@@ -21,10 +22,12 @@ from . import compat
 from ._cpp import ConvergenceError, SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
+from .mpi import raise_on_every_rank
 from .names import FlexibilityMethod, check_chain, check_flexibility_method
-from .pairing import pair_interfaces
+from .pairing import PAIRINGS, pair_interfaces
 from .postprocess import (STATE_NAMES, ContactFields, IncrementResult,  # noqa: F401
                           IncrementSummary, record_increment)
+from .rigid import RigidTarget
 from .rigid_modes import check_bodies
 
 # Annotations use DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never at run time.
@@ -34,34 +37,93 @@ if TYPE_CHECKING:
     from dolfinx.mesh import MeshTags
 
 
+ZONE_EDGE_ACTIONS = ("warn", "error", "ignore")
+
+
+class ContactZoneWarning(UserWarning):
+    """Contact reached the edge of a tagged candidate surface (see zone.py)."""
+
+
+class ContactZoneError(RuntimeError):
+    """Contact reached the edge of a tagged candidate surface and the interface asked for
+    an error (``zone_edge="error"``); the increment is recorded before it is raised."""
+
+
 @dataclass
 class ContactInterface:
-    """Two tagged contact surfaces and their Coulomb friction coefficient.
+    """Two tagged contact surfaces, or a tagged surface and a rigid target, and their
+    Coulomb friction coefficient.
 
-    ``slave`` is the contact surface (the softer body's, in the seed's words) and ``master``
-    the target; the master's outward normal defines the local frame. ``tolerance_m`` is the
-    largest tangential offset between paired nodes (default: 1e-6 of the surfaces' extent).
+    ``slave`` is the tag of the surface whose nodes are paired; ``master`` the tag of the
+    target surface, or a RigidTarget (rigid.py: a plane, circle or sphere with no DOFs).
+    The master's outward normal defines the local frame.
+
+    ``pairing`` chooses the model for two tagged surfaces (DESIGN.md §2):
+
+    * "node_to_node" (default): each slave node with the master node on its master normal
+      line. Needs matching interface nodes, and master normals along the lines joining
+      them: make the flat surface the master when the other is curved.
+    * "node_to_surface": each slave node with its closest point on the master facets
+      (non-matching meshes, curved surfaces, either body as slave); pairs are re-made before
+      every increment from the current positions, with the F* computed once on all nodes
+      of both tagged surfaces (so tag them generously: the candidate zone).
+
+    ``tolerance_m`` is the largest tangential offset between node–node pairs (default:
+    1e-6 of the surfaces' extent). ``zone_edge`` is what happens when a pair closes at an
+    open edge of a candidate surface (zone.py): "warn" (a ContactZoneWarning), "error"
+    (ContactZoneError after the increment is recorded) or "ignore"; the increment summary
+    lists the interface in ``zone_edge`` either way.
     """
 
     facet_tags: MeshTags
     slave: int
-    master: int
+    master: Union[int, RigidTarget]
     mu: float
     tolerance_m: Optional[float] = None
     name: str = ""
+    pairing: str = "node_to_node"
+    zone_edge: str = "warn"
 
     def __post_init__(self):
-        mu = self.mu
-        if not isinstance(mu, (int, float, np.floating)) or not math.isfinite(mu) or mu < 0:
-            raise ValueError(f"contact interface {self.label}: friction coefficient mu={mu!r}; "
-                             "it must be a finite number ≥ 0")
+        self.mu = _friction_coefficient(self.mu, self.label)
+        if self.pairing not in PAIRINGS:
+            raise ValueError(f"contact interface {self.label}: pairing={self.pairing!r}; it "
+                             f"must be one of {', '.join(map(repr, PAIRINGS))}")
+        if self.zone_edge not in ZONE_EDGE_ACTIONS:
+            raise ValueError(f"contact interface {self.label}: zone_edge={self.zone_edge!r};"
+                             f" it must be one of {', '.join(map(repr, ZONE_EDGE_ACTIONS))}")
+        if not isinstance(self.master, (int, np.integer, RigidTarget)):
+            raise TypeError(f"contact interface {self.label}: master={self.master!r}; it "
+                            "must be a facet tag value or a RigidTarget")
         if self.slave == self.master:
             raise ValueError(f"contact interface {self.label}: slave and master are the same "
                              f"tag ({self.slave})")
 
     @property
     def label(self) -> str:
-        return self.name or f"slave tag {self.slave} / master tag {self.master}"
+        if self.name:
+            return self.name
+        master = (f"rigid target {self.master.name!r}" if isinstance(self.master, RigidTarget)
+                  else f"master tag {self.master}")
+        return f"slave tag {self.slave} / {master}"
+
+    @property
+    def rigid(self) -> bool:
+        return isinstance(self.master, RigidTarget)
+
+
+def _friction_coefficient(mu, label: str) -> float:
+    """μ as a float: a Python or NumPy real number, or a 0-d array; finite and ≥ 0."""
+    value = None
+    if not isinstance(mu, (bool, np.bool_)):
+        arr = np.asarray(mu) if isinstance(mu, (int, float, np.number, np.ndarray)) else None
+        if arr is not None and arr.ndim == 0 and np.issubdtype(arr.dtype, np.number) \
+                and not np.issubdtype(arr.dtype, np.complexfloating):
+            value = float(arr)
+    if value is None or not math.isfinite(value) or value < 0:
+        raise ValueError(f"contact interface {label}: friction coefficient mu={mu!r}; "
+                         "it must be a finite real number ≥ 0 (a Python or NumPy scalar)")
+    return value
 
 
 class ContactProblem:
@@ -85,6 +147,9 @@ class ContactProblem:
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
+    Node–surface and rigid-target pairs are re-made before every increment (``repair``);
+    ``factorizations`` counts the sparse factorizations (one) and ``pairings`` how often
+    the pairs were made.
     """
 
     def __init__(self, a: ufl.Form, L: Optional[ufl.Form], bcs: Sequence[DirichletBC],
@@ -118,10 +183,16 @@ class ContactProblem:
         if bodies is not None:
             cell_tags, names = bodies
             check_bodies(self.K, self.V, cell_tags, names, self.comm)
+        t0 = time.perf_counter()
         self.pairs, self.mu, self.m = pair_interfaces(self.V, self.interfaces, self.comm)
+        self.timings["pairing_s"] = time.perf_counter() - t0
+        # Node–surface and rigid-target pairs follow the bodies: re-made before each increment.
+        self.repairing = any(i.rigid or i.pairing != "node_to_node" for i in self.interfaces)
+        self.pairings = 1
         self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
                                          self.comm, self.options, self.flexibility_method)
         c = self.condensation
+        self.factorizations = c.factorizations
         self.timings.update(c.timings)
         self.factor, self.flex_info, self.n_contact_dofs = c.factor, c.flex_info, c.n_contact_dofs
         self.contact, self.B, self.W, self.x0, self.frames = c.contact, c.B, c.W, c.x0, c.frames
@@ -136,10 +207,14 @@ class ContactProblem:
         t0 = time.perf_counter()
         root = self.comm.rank == 0
         number = len(self.increments) + 1
+        if self.repairing:
+            self.repair()
         p = assemble_load(self.V, self.a_form, self.L_form, self.bcs, self.comm)
         up = self.K.createVecRight()
         self.factor.solve(p, up)
         upc = self.condensation.gather(up)
+        if root:
+            upc = self.condensation.contact_values(upc)
         out, failure = None, None
         if root:
             try:
@@ -174,7 +249,55 @@ class ContactProblem:
                                time.perf_counter() - t0)
         self.increments.append(inc)
         self.outputs.write_back(inc, self.pairs)
+        self._guard_zone(inc)
         return inc
+
+    def repair(self) -> None:
+        """Re-make node–surface and rigid-target pairs at the current positions (the last
+        increment's displacement, the rigid targets' displacement as set now): B, x0 and W
+        are rebuilt from the stored F*, with no new factorization. Collective."""
+        uc = self.condensation.gather(compat.petsc_vec(self.u))
+        error = None
+        if self.comm.rank == 0:
+            try:
+                self.pairs.repair(self.condensation.contact_values(uc))
+                self.condensation.set_pairs(self.pairs, self.mu)
+            except ValueError as e:
+                error = f"increment {len(self.increments) + 1}: re-pairing: {e}"
+            c = self.condensation
+            self.contact, self.B, self.W, self.x0, self.frames = (c.contact, c.B, c.W, c.x0,
+                                                                  c.frames)
+        raise_on_every_rank(self.comm, error)
+        self.pairings += 1
+
+    def _guard_zone(self, inc: IncrementResult) -> None:
+        """Name the interfaces whose contact reached an open edge of a candidate surface
+        (zone.py) in the increment's summary; warn or raise as each interface asks."""
+        labels = None
+        if self.comm.rank == 0:
+            edge = getattr(self.pairs, "at_edge", None)
+            where = getattr(self.pairs, "interface", None)
+            labels = []
+            if edge is not None and where is not None:
+                hit = np.unique(where[(inc.states > 0) & edge])
+                labels = [self.interfaces[int(i)].label for i in hit]
+        labels = self.comm.bcast(labels, root=0)
+        inc.summary.zone_edge = labels
+        n = inc.summary.increment
+        errors = []
+        for itf in self.interfaces:
+            if itf.label not in labels or itf.zone_edge == "ignore":
+                continue
+            text = (f"contact interface {itf.label}: increment {n}: contact reached the edge "
+                    "of the tagged candidate surface (a pair closed at its open edge); the "
+                    "contact zone may extend past the tagged zone: tag a larger candidate "
+                    "surface")
+            if itf.zone_edge == "error":
+                errors.append(text)
+            elif self.comm.rank == 0:
+                warnings.warn(text, ContactZoneWarning, stacklevel=3)
+        if errors:
+            raise ContactZoneError("; ".join(errors))
 
     # ---- driver -------------------------------------------------------------------
     def solve(self, increments: int, load: Optional[Callable[[int, float], None]] = None,

@@ -45,6 +45,28 @@ def _modes(X, gdim):
     return modes
 
 
+def _name_modes(Y: np.ndarray, N: np.ndarray) -> list:
+    """One basic rigid mode (translation or rotation) per free motion, each named once.
+
+    Y spans the free motions in mode coordinates, N is the modes' Gram matrix. Greedily: the
+    basic mode with the largest share in the free subspace (N-orthogonal projection) is
+    named, that direction is removed from the subspace, and so on."""
+    w, U = np.linalg.eigh(Y.T @ N @ Y)
+    Q = Y @ U / np.sqrt(np.maximum(w, 1e-300))          # N-orthonormal basis of the subspace
+    chosen = []
+    while Q.shape[1] and len(chosen) < N.shape[0]:
+        coords = Q.T @ N                                   # column i: coordinates of P e_i
+        share = np.linalg.norm(coords, axis=0) / np.sqrt(np.diag(N))
+        share[chosen] = -1.0
+        i = int(np.argmax(share))
+        chosen.append(i)
+        c = coords[:, i] / max(np.linalg.norm(coords[:, i]), 1e-300)
+        # The subspace without that direction: an orthonormal basis of c's complement.
+        H = np.linalg.svd(np.eye(c.size) - np.outer(c, c))[0][:, :c.size - 1]
+        Q = Q @ H
+    return sorted(chosen)
+
+
 def check_bodies(K, V, cell_tags, bodies: dict, comm=MPI.COMM_WORLD, rel_tol: float = 1e-9):
     """Raise ValueError naming each body whose rigid modes K does not resist.
 
@@ -68,6 +90,14 @@ def check_bodies(K, V, cell_tags, bodies: dict, comm=MPI.COMM_WORLD, rel_tol: fl
         size = max(np.sqrt(r2), 1e-300)
         dofs = (blocks[:, None] * bs + np.arange(gdim)[None, :]).ravel()
         kdiag = comm.allreduce(float(np.max(np.abs(diag.array[dofs]), initial=0.0)), op=MPI.MAX)
+        unstiff = comm.allreduce(int(np.count_nonzero(diag.array[dofs] == 0.0)), op=MPI.SUM)
+        if unstiff:
+            # A body with no material has no stiffness at all: not a support problem.
+            problems.append(f"body '{name}' (cell tag {value}) has no stiffness at "
+                            f"{unstiff} of its {count * gdim} DOFs: its cells carry no "
+                            "material in the bilinear form (is cell tag "
+                            f"{value} missing from the materials?)")
+            continue
         Z, KZ = [], []
         for mode in _modes(X / size, gdim):
             z = K.createVecRight()
@@ -86,12 +116,12 @@ def check_bodies(K, V, cell_tags, bodies: dict, comm=MPI.COMM_WORLD, rel_tol: fl
         for v in Z + KZ:
             v.destroy()
         free = [i for i in range(k) if theta[i] <= rel_tol * kdiag]
-        for i in free:
-            y = Li.T @ vecs[:, i]
-            dominant = int(np.argmax(np.abs(y)))
+        if free:
+            Y = Li.T @ vecs[:, free]               # free motions, in mode coordinates
+            names = [_MODE_NAMES[gdim][i] for i in _name_modes(Y, N)]
             problems.append(f"body '{name}' (cell tag {value}) can move freely: "
-                            f"{_MODE_NAMES[gdim][dominant]} is not prevented by any "
-                            f"Dirichlet condition")
+                            f"{', '.join(names)} {'is' if len(names) == 1 else 'are'} not "
+                            "prevented by any Dirichlet condition (a static problem needs "
+                            "every body held)")
     if problems:
-        raise ValueError("the stiffness matrix is singular (a static problem needs every "
-                         "body held by Dirichlet conditions): " + "; ".join(problems))
+        raise ValueError("the stiffness matrix is singular: " + "; ".join(problems))

@@ -28,7 +28,10 @@ def surface_nodes(V, facet_tags, value: int) -> dict:
         On rank 0 a dict with "x" (n, gdim) coordinates [m], "dofs" (n, bs) global DOF
         indices (node·bs + component), "normal" (n, gdim) unit outward normals, "area" (n,)
         tributary length (2D) [m] or area (3D) [m²]; nodes sorted lexicographically by
-        coordinates. Other ranks get arrays with no rows. Collective.
+        coordinates; "facets" (nf, nv) the rows of each facet's vertices in "x" (reference
+        order of the facet: segment ends, triangle corners, or quadrilateral corners
+        (0,0), (1,0), (0,1), (1,1)) and "facet_normal" (nf, gdim) their unit outward
+        normals. Other ranks get arrays with no rows. Collective.
 
     Raises:
         ValueError: if no facet carries ``value`` (the message lists the values present),
@@ -51,8 +54,7 @@ def surface_nodes(V, facet_tags, value: int) -> dict:
 
     gathered = comm.gather((nodes, X, normal, measure), root=0)
     if comm.rank != 0:
-        return {"x": np.zeros((0, gdim)), "dofs": np.zeros((0, bs), np.int64),
-                "normal": np.zeros((0, gdim)), "area": np.zeros(0)}
+        return _empty(gdim, bs, X.shape[1])
     nodes, X, normal, measure = (np.concatenate(p) for p in zip(*gathered))
     return _merge(nodes, X, normal, measure, gdim, bs)
 
@@ -123,13 +125,17 @@ def _outward_normals(X, centroid, gdim):
     return n, measure
 
 
+def _empty(gdim, bs, nv):
+    return {"x": np.zeros((0, gdim)), "dofs": np.zeros((0, bs), np.int64),
+            "normal": np.zeros((0, gdim)), "area": np.zeros(0),
+            "facets": np.zeros((0, nv), np.int64), "facet_normal": np.zeros((0, gdim))}
+
+
 def _merge(nodes, X, normal, measure, gdim, bs):
     """Each facet once (key: its sorted node numbers), then sums per node, sorted."""
     nv = nodes.shape[1]
-    empty = {"x": np.zeros((0, gdim)), "dofs": np.zeros((0, bs), np.int64),
-             "normal": np.zeros((0, gdim)), "area": np.zeros(0)}
     if nodes.shape[0] == 0:
-        return empty
+        return _empty(gdim, bs, nv)
     _, first = np.unique(np.sort(nodes, axis=1), axis=0, return_index=True)
     nodes, X, normal, measure = nodes[first], X[first], normal[first], measure[first]
     ids, inverse = np.unique(nodes.reshape(-1), return_inverse=True)
@@ -145,5 +151,8 @@ def _merge(nodes, X, normal, measure, gdim, bs):
     # Lexicographic by coordinates, then by global number (np.lexsort: last key first).
     order = np.lexsort((ids,) + tuple(x[:, k] for k in reversed(range(gdim))))
     dofs = ids[order, None] * bs + np.arange(bs)[None, :]
+    row = np.empty(ids.size, np.int64)
+    row[order] = np.arange(ids.size)
     return {"x": x[order], "dofs": dofs.astype(np.int64), "normal": n[order],
-            "area": area[order]}
+            "area": area[order], "facets": row[inverse].reshape(-1, nv),
+            "facet_normal": normal}

@@ -21,6 +21,9 @@ struct ContactPair
   std::vector<int> masters;       ///< contact node indices of the master point's nodes
   std::vector<double> weights;    ///< shape weights w_j of the master point (sum 1)
   Matrix frame;                   ///< d×d rotation, rows n, t (, t2)
+  /// Normal distance of the master surface from the master point [m], subtracted from the
+  /// normal gap: a rigid circle or sphere pairs its slaves with its centre and offset R.
+  double offset = 0.0;
 };
 
 /// @brief Local frame from a unit outward normal: rows (n, t) with t = (−n_y, n_x) in 2D;
@@ -34,8 +37,8 @@ Matrix frame_from_normal(const Eigen::Ref<const Vector>& n);
 Eigen::SparseMatrix<double> gap_operator(int dim, int n_nodes,
                                          const std::vector<ContactPair>& pairs);
 
-/// @brief Initial gap x0 (m·d): x0_k = T_k (X_s − Σ_j w_j X_j); X holds node coordinates
-/// row by row (n_nodes × d).
+/// @brief Initial gap x0 (m·d): x0_k = T_k (X_s − Σ_j w_j X_j) − offset_k e_n; X holds node
+/// coordinates row by row (n_nodes × d).
 Vector initial_gap(const std::vector<ContactPair>& pairs, const Eigen::Ref<const Matrix>& X);
 
 /// @brief W = B F* Bᵀ, symmetrised. F* is the flexibility (K⁻¹)_cc on the contact DOFs.

@@ -1,0 +1,88 @@
+"""Closest-point projection on master facets, rigid analytic targets and the friction
+coefficient's accepted types: hand values from geometry (no mesh, no solve)."""
+import math
+
+import numpy as np
+import pytest
+
+import flexcontact as fc
+from flexcontact.problem import _friction_coefficient
+from flexcontact.projection import boundary_nodes, closest_points, nodal_normals, facet_normals
+
+
+def test_segments_inside_and_beyond_the_end():
+    X = np.array([[0.0, 0.0], [2.0, 0.0], [3.0, 1.0]])
+    facets = np.array([[0, 1], [1, 2]])
+    P = np.array([[0.5, 1.0], [-1.0, 0.5], [2.5, 0.5 + 1e-3]])
+    f, w, border = closest_points(P, X, facets)
+    assert f[0] == 0 and np.allclose(w[0], [0.75, 0.25], atol=1e-15) and not border[0]
+    assert f[1] == 0 and np.allclose(w[1], [1.0, 0.0]) and border[1]
+    # (2.5, 0.5) lies on the second segment: its midpoint; the weights reproduce the point.
+    assert f[2] == 1
+    assert np.allclose(w[2] @ X[facets[1]], [2.5 + 5e-4, 0.5 + 5e-4], atol=1e-12)
+
+
+def test_triangle_interior_and_edge():
+    X = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    facets = np.array([[0, 1, 2]])
+    f, w, border = closest_points(np.array([[0.2, 0.3, 0.5], [2.0, 2.0, 1.0]]), X, facets)
+    assert np.allclose(w[0], [0.5, 0.2, 0.3], atol=1e-14) and not border[0]
+    # Beyond the hypotenuse: its midpoint (0.5, 0.5, 0).
+    assert np.allclose(w[1], [0.0, 0.5, 0.5], atol=1e-14) and border[1]
+
+
+def test_bilinear_quadrilateral_weights():
+    # A planar, non-parallelogram quadrilateral, corners in tensor order (0,0), (1,0), (0,1),
+    # (1,1); a point above x(ξ, η) has the bilinear shape functions at (ξ, η) as weights.
+    X = np.array([[0.0, 0, 0], [2, 0, 0], [0, 1, 0], [3, 2, 0]])
+    s, t = 0.3, 0.6
+    N = np.array([(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t])
+    P = (N @ X + [0, 0, 0.4])[None]
+    f, w, border = closest_points(P, X, np.array([[0, 1, 2, 3]]))
+    assert np.allclose(w[0], N, atol=1e-10) and not border[0]
+
+
+def test_boundary_and_normals_of_a_strip():
+    # Two triangles forming the unit square: boundary = all 4 nodes; normals +z.
+    X = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    facets = np.array([[0, 1, 3], [0, 3, 2]])
+    assert boundary_nodes(facets, 3, 4).all()
+    fn = facet_normals(X, facets, np.array([[0, 0, 1.0], [0, 0, 1.0]]))
+    assert np.allclose(nodal_normals(X, facets, fn), [0, 0, 1])
+    # 2D chain of three segments: only the two ends are boundary nodes.
+    assert boundary_nodes(np.array([[0, 1], [1, 2], [2, 3]]), 2, 4).tolist() == \
+        [True, False, False, True]
+
+
+def test_rigid_circle_normals_and_offsets():
+    c = fc.RigidTarget("circle", point_m=(1.0, 2.0), radius_m=0.5)
+    c.displacement_m = np.array([0.0, -1.0])
+    n, off = c.normals_and_offsets(np.array([[4.0, 5.0]]))
+    assert np.allclose(n, [[0.6, 0.8]]) and off.tolist() == [0.5]
+    p = fc.RigidTarget("plane", point_m=(0, 0, 0), normal=(0, 0, 2.0))
+    assert np.allclose(p.normal, [0, 0, 1])
+
+
+@pytest.mark.parametrize("kwargs, word", [
+    (dict(kind="cone", point_m=(0, 0)), "kind"),
+    (dict(kind="plane", point_m=(0, 0), normal=(0, 0)), "normal"),
+    (dict(kind="circle", point_m=(0, 0), radius_m=-1.0), "radius_m"),
+    (dict(kind="sphere", point_m=(0, 0), radius_m=1.0), "sphere lives in 3D"),
+    (dict(kind="circle", point_m=(0, math.nan), radius_m=1.0), "point_m"),
+])
+def test_rigid_target_bad_input(kwargs, word):
+    with pytest.raises(ValueError, match=word):
+        fc.RigidTarget(**kwargs)
+
+
+@pytest.mark.parametrize("mu", [np.float32(0.25), np.float64(0.25), np.array(0.25),
+                                np.int64(0), 0.25, 0])
+def test_friction_coefficient_numpy_scalars(mu):
+    assert _friction_coefficient(mu, "x") == pytest.approx(float(mu), rel=1e-7)
+
+
+@pytest.mark.parametrize("mu", [np.array([0.3]), True, "0.3", -0.1, np.array(math.nan),
+                                1 + 1j])
+def test_friction_coefficient_rejected(mu):
+    with pytest.raises(ValueError, match="friction coefficient"):
+        _friction_coefficient(mu, "x")
