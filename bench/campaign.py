@@ -9,7 +9,7 @@ bench/campaign.json: per class, how many each solved, wrong answers claimed (mus
 problems the chain lost that another solver solved (must be 0), the worst residual of a
 claimed answer, and median times.
 
-    /usr/bin/python3 bench/campaign.py [--count 10000] [--large 20] [--seed 1]
+    /usr/bin/python3 bench/campaign.py [--count 10000] [--large 4] [--seed 1]   # about 40 min
 """
 import argparse
 import json
@@ -27,7 +27,7 @@ from random_problems import SOLVERS, run_flexcontact, run_siconos, sample  # noq
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("--count", type=int, default=10000, help="problems with up to 60 pairs")
-ap.add_argument("--large", type=int, default=20, help="problems with 300-1000 pairs")
+ap.add_argument("--large", type=int, default=4, help="problems with 300-1000 pairs (minutes each)")
 ap.add_argument("--seed", type=int, default=1)
 ap.add_argument("--tolerance", type=float, default=1e-10)
 ap.add_argument("--no-siconos", action="store_true")
@@ -44,6 +44,37 @@ except ImportError:
 def progress(i, n, t0):
     if i % 250 == 0 or i == n:
         print(f"  {i}/{n} problems, {time.perf_counter() - t0:.0f} s", flush=True)
+
+
+def summary(outcomes):
+    claimed = [o.residual for o in outcomes if o.claimed]
+    return {"problems": len(outcomes), "solved": sum(o.solved for o in outcomes),
+            "claimed": len(claimed), "wrong": sum(o.wrong for o in outcomes),
+            "worst_claimed_residual": max(claimed) if claimed else None,
+            "median_time_s": float(np.median([o.time_s for o in outcomes])),
+            "max_time_s": max(o.time_s for o in outcomes)}
+
+
+def report(done, final):
+    """Write campaign.json (also on the way, so that a long run leaves results)."""
+    classes = {k: {s: summary(v) for s, v in rows.items()} for k, rows in sorted(by_class.items())}
+    result = {"tolerance": args.tolerance, "seed": args.seed, "problems": len(problems),
+              "done": done, "siconos": siconos, "wrong_answers": wrong,
+              "lost_by_the_chain": lost, "classes": classes,
+              "time_s": time.perf_counter() - t0}
+    Path(args.out).write_text(json.dumps(result, indent=1))
+    if not final:
+        return
+    for k, rows in classes.items():
+        chain = rows["chain"]
+        line = (f"{k:28s} chain {chain['solved']}/{chain['problems']} "
+                f"median {1e3 * chain['median_time_s']:.2f} ms")
+        for s in ("active_set", "projection", "newton_ac", "siconos_NSN_AC"):
+            if s in rows:
+                line += f" | {s} {rows[s]['solved']} ({1e3 * rows[s]['median_time_s']:.2f} ms)"
+        print(line)
+    print(f"{done} problems in {result['time_s']:.0f} s: {len(wrong)} wrong answers "
+          f"claimed, {len(lost)} lost by the chain; wrote {args.out}")
 
 
 t0 = time.perf_counter()
@@ -64,29 +95,8 @@ for i, p in enumerate(problems, 1):
     if not row["chain"].solved and any(o.solved for o in row.values()):
         lost.append({"problem": p.name, **{s: o.residual for s, o in row.items()}})
     progress(i, len(problems), t0)
+    if i % 1000 == 0:
+        report(i, final=False)
+report(len(problems), final=True)
 
 
-def summary(outcomes):
-    claimed = [o.residual for o in outcomes if o.claimed]
-    return {"problems": len(outcomes), "solved": sum(o.solved for o in outcomes),
-            "claimed": len(claimed), "wrong": sum(o.wrong for o in outcomes),
-            "worst_claimed_residual": max(claimed) if claimed else None,
-            "median_time_s": float(np.median([o.time_s for o in outcomes])),
-            "max_time_s": max(o.time_s for o in outcomes)}
-
-
-classes = {k: {s: summary(v) for s, v in rows.items()} for k, rows in sorted(by_class.items())}
-for k, rows in classes.items():
-    chain = rows["chain"]
-    line = (f"{k:28s} chain {chain['solved']}/{chain['problems']} "
-            f"median {1e3 * chain['median_time_s']:.2f} ms")
-    for s in ("active_set", "projection", "newton_ac", "siconos_NSN_AC"):
-        if s in rows:
-            line += f" | {s} {rows[s]['solved']} ({1e3 * rows[s]['median_time_s']:.2f} ms)"
-    print(line)
-result = {"tolerance": args.tolerance, "seed": args.seed, "problems": len(problems),
-          "siconos": siconos, "wrong_answers": wrong, "lost_by_the_chain": lost,
-          "classes": classes, "time_s": time.perf_counter() - t0}
-Path(args.out).write_text(json.dumps(result, indent=1))
-print(f"{len(problems)} problems in {result['time_s']:.0f} s: {len(wrong)} wrong answers "
-      f"claimed, {len(lost)} lost by the chain; wrote {args.out}")
