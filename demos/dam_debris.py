@@ -148,7 +148,7 @@ if comm.rank == 0:
 
 # %% [markdown]
 # ## Stage 2: the impact
-# The log, free now, drifts downstream (+x) at `--log-speed` and hits the upstream face;
+# The log, free now, moves along its axis at `--log-speed` and hits the upstream face;
 # the dam and foundation start from stage 1's displacement under the same constant loads,
 # so they are at rest until the log arrives. The log's density is raised by the added-mass
 # coefficient, ρ_wood (1 + C_a), and its weight and buoyancy cancel. Contact: the log's
@@ -167,7 +167,7 @@ if comm.rank == 0:
 
 # %%
 if not args.stage1_only:
-    from flexcontact.dam.stage2 import solve_stage2
+    from flexcontact.dam.stage2 import approach_time_s, solve_stage2
     from flexcontact.impact_output import plot_history, write_history_csv
     with fc.ResultWriter(folder, "impact", msh, tags=(cells,)) as xdmf:
         stage2 = solve_stage2(s, stage1, dt_s=args.dt, offset_m=args.impact_offset,
@@ -189,7 +189,7 @@ if not args.stage1_only:
         "log_velocity_after_m_s": stage2.log_velocity_after,
         "peak_force_N_per_m" if s.dim == 2 else "peak_force_N": met["peak_force"],
         "contact_start_s": met["contact_start_s"],
-        "contact_start_s_ref": s.log_gap_m / s.log_speed_m_s,
+        "contact_start_s_ref": approach_time_s(s),
         "contact_duration_s": met["contact_duration_s"],
         "contact_duration_s_ref_log_2L_c": p2.expected_contact_s,
         "contact_episodes": met["episodes"],

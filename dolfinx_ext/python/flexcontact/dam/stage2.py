@@ -7,8 +7,8 @@ Starts from stage 1 (:mod:`flexcontact.dam.stage1`) on the same mesh and functio
 * loads: the stage-1 loads (self-weight, water on the faces) kept constant, and the
   initial displacement is stage 1's, so the dam and foundation start in equilibrium and
   stay there until the log arrives. The log gets no load: its weight and buoyancy cancel;
-* the log moves horizontally downstream (+x, drifting with the flow towards the face) at
-  ``log_speed_m_s``; the water it drags along is added as mass: its density is
+* the log moves at ``log_speed_m_s`` along its axis (``scenario.log_axis``, pointing at
+  the dam), as the scenario defines its approach; the water it drags along is added as mass: its density is
   ρ_wood (1 + C_a) with C_a the scenario's ``added_mass_coefficient`` (see scenario.py),
   its stiffness unchanged;
 * contact: the log's front end (slave; with the pitched log its lower front corner hits
@@ -104,8 +104,7 @@ def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
     materials = {T.DAM: s.concrete, T.FOUNDATION: s.rock, T.LOG: log_material(s)}
     contact = ContactInterface(mesh.facet_tags, slave=T.LOG_FRONT, master=T.DAM_UPSTREAM,
                                mu=s.friction_mu, name="log/dam", pairing="node_to_surface")
-    speed = np.zeros(s.dim)
-    speed[0] = s.log_speed_m_s
+    speed = s.log_speed_m_s * np.asarray(s.log_axis, dtype=float)
     return ImpactProblem(
         V, mesh.cell_tags, {"dam": T.DAM, "foundation": T.FOUNDATION, "log": T.LOG},
         materials, stage2_supports(s, V, mesh), contact, dt_s=dt_s, kind=stage1.kind,
@@ -120,7 +119,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     """Run the impact from ``stage1`` (a Stage1Result of the same scenario). Collective.
 
     ``dt_s``: time step (default :func:`default_time_step_s`); ``duration_s``: simulated
-    time (default: the approach gap/speed plus MARGIN × 2L/c of the log); ``offset_m``: the
+    time (default: the approach gap / (speed · x) plus MARGIN × 2L/c of the log); ``offset_m``: the
     distance from the first-contact point on the face at which the largest principal
     stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
     ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps.
@@ -136,7 +135,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     problem = make_problem(s, stage1, dt)
     t_setup = time.perf_counter() - t0
     if duration_s is None:
-        duration_s = s.log_gap_m / s.log_speed_m_s + MARGIN * problem.expected_contact_s
+        duration_s = approach_time_s(s) + MARGIN * problem.expected_contact_s
     impact = np.zeros(s.dim)
     impact[-1] = s.log_front_point[-1]
     if s.dim == 3:
@@ -167,8 +166,14 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
                                    "dt_s": dt, "duration_s": duration_s, "steps_n": n})
 
 
+def approach_time_s(s) -> float:
+    """Time for the log to cross the gap to the face: gap / (its velocity's x component)."""
+    return s.log_gap_m / (s.log_speed_m_s * float(s.log_axis[0]))
+
+
 def _log_momentum(problem) -> tuple[float, float, float]:
     """The log's mass (Σ M over its x DOFs, with the added mass) and its mean x velocity
+    (along the face's normal)
     before and after, from the momenta of its nodes (M v summed over the log's x DOFs)."""
     log = next(b for b in problem.bodies if b.name == "log")
     ones = problem.K.createVecLeft()
