@@ -249,3 +249,10 @@ def test_demo_serial_and_two_ranks_agree(tmp_path):
     h = serial["scenario"]["water_level_m"]
     assert abs(serial["stage1"]["hydrostatic_resultant_N"] / (RHO_W * G * h * h / 2) - 1) < 1e-6
     assert par["mesh"]["ranks"] == 2
+    assert (folder / "impact.xdmf").is_file() and (folder / "impact_force.csv").is_file()
+    for key in ("peak_force_N_per_m", "impulse_N_s_per_m", "contact_duration_s",
+                "peak_max_principal_stress_near_impact_Pa"):
+        got, other = serial["stage2"][key], par["stage2"][key]
+        assert abs(other - got) <= 1e-8 * abs(got), (key, other, got)
+    imp = serial["stage2"]
+    assert abs(imp["impulse_N_s_per_m"] - imp["impulse_ref"]) <= 0.01 * imp["impulse_ref"]

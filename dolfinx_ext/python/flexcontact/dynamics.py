@@ -86,6 +86,8 @@ class ImpactProblem:
     mass : "consistent" or "lumped" (row sum).
     rayleigh : (α, β) of C = αM + βK.
     loads : UFL linear form of constant external loads, or None.
+    initial_displacement : a Function on V (m) to start from, e.g. a static state under
+        ``loads`` (zeroed at held DOFs); None: zero. Its strain energy is the initial one.
     solver, flexibility : as for ContactProblem.
     """
 
@@ -97,7 +99,7 @@ class ImpactProblem:
                  theta: float = 0.5, mass: str = "consistent",
                  rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
                  solver: Optional[SolverOptions] = None, flexibility: str = "schur",
-                 expected_contact_s: Optional[float] = None):
+                 expected_contact_s: Optional[float] = None, initial_displacement=None):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)
@@ -131,7 +133,7 @@ class ImpactProblem:
                                    self.bcs)
         self.timings["assemble_s"] = time.perf_counter() - t0
         self._factor_iteration_matrix(flexibility)
-        self._init_state(initial_velocity)
+        self._init_state(initial_velocity, initial_displacement)
         lame = forms.lame_fields(self.msh, cell_tags, materials)
         self.outputs = ContactFields(V, self.comm, lambda w: forms.von_mises(w, lame, kind))
         self.velocity = dolfinx.fem.Function(V, name="velocity")
@@ -174,9 +176,16 @@ class ImpactProblem:
         self.timings.update(c.timings)
         self.timings["iteration_matrix_s"] = time.perf_counter() - t0
 
-    def _init_state(self, initial_velocity: Optional[dict]) -> None:
+    def _init_state(self, initial_velocity: Optional[dict], initial_displacement=None) -> None:
         self.u_vec = self.K.createVecLeft()
         self.u_vec.zeroEntries()
+        strain0 = 0.0
+        if initial_displacement is not None:
+            setup.initial_displacement(self.u_vec, initial_displacement, self.V, self.marker)
+            Ku = self.K.createVecLeft()
+            self.K.mult(self.u_vec, Ku)
+            strain0 = 0.5 * self.u_vec.dot(Ku)
+            Ku.destroy()
         self.v_vec = self.K.createVecLeft()
         setup.initial_velocity(self.v_vec, self.bodies, initial_velocity, self.marker,
                                self.dim)
@@ -184,7 +193,7 @@ class ImpactProblem:
         self.energy = EnergyAccount()
         Mv = self._work[0]
         self.M.mult(self.v_vec, Mv)
-        self.energy.start(0.5 * Mv.dot(self.v_vec), 0.0)
+        self.energy.start(0.5 * Mv.dot(self.v_vec), strain0)
         self.momentum0 = self._momentum(Mv)
 
     def _momentum(self, Mv: PETSc.Vec) -> dict:

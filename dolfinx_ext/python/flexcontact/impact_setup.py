@@ -220,6 +220,22 @@ def initial_velocity(v: PETSc.Vec, bodies: Sequence[Body], velocities: dict,
     v.pointwiseMult(v, marker)
 
 
+def initial_displacement(u: PETSc.Vec, u0, V, marker: PETSc.Vec) -> None:
+    """u = the Function ``u0`` [m] on V's owned DOFs, zero at held DOFs."""
+    x = getattr(u0, "x", None)
+    n = u.getLocalSize()
+    owned = None if x is None else u0.function_space.dofmap.index_map.size_local * \
+        u0.function_space.dofmap.index_map_bs
+    if owned != n:
+        raise ValueError(f"initial_displacement={u0!r}: must be a Function on the problem's "
+                         f"vector space V ({n} owned values on this rank, got {owned})")
+    vals = x.array[:n]
+    if not np.all(np.isfinite(vals)):
+        raise ValueError("initial_displacement has non-finite values")
+    u.array[:] = vals
+    u.pointwiseMult(u, marker)
+
+
 def load_vector(V, L_form, bcs: Sequence) -> Optional[PETSc.Vec]:
     """The constant external load f [N] with zeros at Dirichlet DOFs, or None."""
     if L_form is None:

@@ -1,0 +1,189 @@
+"""Stage 2 of the dam scenario: the floating log hits the dam's upstream face.
+
+Starts from stage 1 (:mod:`flexcontact.dam.stage1`) on the same mesh and function space:
+
+* supports: those of stage 1 on the foundation, without the hold on the log (the log is a
+  free body; the Moreau–Jean iteration matrix M + hθC + h²θ²K is regular without one);
+* loads: the stage-1 loads (self-weight, water on the faces) kept constant, and the
+  initial displacement is stage 1's, so the dam and foundation start in equilibrium and
+  stay there until the log arrives. The log gets no load: its weight and buoyancy cancel;
+* the log moves at ``log_speed_m_s`` along its axis (``scenario.log_axis``, pointing at
+  the dam), as the scenario defines its approach; the water it drags along is added as mass: its density is
+  ρ_wood (1 + C_a) with C_a the scenario's ``added_mass_coefficient`` (see scenario.py),
+  its stiffness unchanged;
+* contact: the log's front end (slave; with the pitched log its lower front corner hits
+  first) against the dam's upstream face (master), node–surface with the scenario's μ.
+  The pairs are made once from the initial positions and kept for the whole run: over the
+  few milliseconds of contact the log slides along the face by far less than an element.
+
+Not modelled: the reservoir's added mass on the dam (Westergaard; ``westergaard=True`` is
+rejected here), water damping, the wood's across-grain softness and crushing.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+import dolfinx.fem
+
+from .. import impact_setup
+from ..boundary import dirichlet
+from ..dynamics import ImpactProblem
+from ..forms import Material
+from ..impact_output import contact_metrics
+from ..meshes import dam_tags as T
+from ..problem import ContactInterface
+from .fields import stress_fields
+from .section import peak_at_offset
+from .stage1 import _measures, body_loads
+
+MARGIN = 1.5
+"""The run lasts approach + MARGIN × the expected contact duration (2L/c of the log)."""
+
+
+@dataclass
+class Stage2Result:
+    """The impact run: the ImpactProblem (state at the end, records per step), the contact
+    metrics (impulse_contact: Σ normal force × dt, N·s/m in 2D), the log's momentum change
+    along x from its nodes, and the peak largest principal stress near the impact point."""
+
+    problem: Any
+    metrics: dict
+    log_momentum_change: float
+    log_mass_effective: float
+    log_velocity_before: float
+    log_velocity_after: float
+    stress_history: list          # (t_s, peak largest principal stress [Pa]) in contact
+    impact_point_m: np.ndarray
+    offset_m: float
+    peak_contact_pressure_Pa: float  # largest mean pressure of a step (impulse/h/area)
+    timings_s: dict = field(default_factory=dict)
+
+    @property
+    def peak_tensile_stress_Pa(self) -> float:
+        vals = [s for _, s in self.stress_history if np.isfinite(s)]
+        return max(vals) if vals else float("nan")
+
+
+def log_material(s) -> Material:
+    """The wood with the added mass of the water: ρ (1 + C_a)."""
+    w = s.wood
+    return Material(E_Pa=w.E_Pa, nu=w.nu, rho_kg_m3=w.rho_kg_m3 * (1.0 + s.added_mass_coefficient),
+                    name="wood+added mass")
+
+
+def stage2_supports(s, V, mesh) -> list:
+    """Stage 1's supports without the hold on the log."""
+    bcs, _ = dirichlet(V, mesh.facet_tags, T.FOUNDATION_BOTTOM)
+    bcs += dirichlet(V, mesh.facet_tags, T.FOUNDATION_SIDES, components=[0])[0]
+    if s.dim == 3:
+        bcs += dirichlet(V, mesh.facet_tags, T.FOUNDATION_FLANKS, components=[1])[0]
+    return bcs
+
+
+def default_time_step_s(s, steps_in_contact: int = 40) -> float:
+    """dt = 2L_x/c of the log (its first wave round trip along x) / ``steps_in_contact``."""
+    c = math.sqrt(s.wood.E_Pa / (s.wood.rho_kg_m3 * (1.0 + s.added_mass_coefficient)))
+    extent = s.log_length_m * abs(s.log_axis[0]) + s.log_diameter_m * math.sqrt(
+        max(1.0 - s.log_axis[0] ** 2, 0.0))
+    return 2.0 * extent / c / steps_in_contact
+
+
+def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
+    """The ImpactProblem of stage 2 (collective)."""
+    mesh, V = stage1.mesh, stage1.V
+    dx, ds = _measures(mesh)
+    v = ufl.TestFunction(V)
+    loads = body_loads(s, v, dx, ds)
+    materials = {T.DAM: s.concrete, T.FOUNDATION: s.rock, T.LOG: log_material(s)}
+    contact = ContactInterface(mesh.facet_tags, slave=T.LOG_FRONT, master=T.DAM_UPSTREAM,
+                               mu=s.friction_mu, name="log/dam", pairing="node_to_surface")
+    speed = s.log_speed_m_s * np.asarray(s.log_axis, dtype=float)
+    return ImpactProblem(
+        V, mesh.cell_tags, {"dam": T.DAM, "foundation": T.FOUNDATION, "log": T.LOG},
+        materials, stage2_supports(s, V, mesh), contact, dt_s=dt_s, kind=stage1.kind,
+        initial_velocity={"log": tuple(speed)}, loads=loads["dam"] + loads["foundation"],
+        initial_displacement=stage1.u)
+
+
+def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
+                 duration_s: Optional[float] = None, offset_m: float = 1.0,
+                 writer=None, write_every: int = 5, stress_every: int = 1,
+                 comm=MPI.COMM_WORLD) -> Stage2Result:
+    """Run the impact from ``stage1`` (a Stage1Result of the same scenario). Collective.
+
+    ``dt_s``: time step (default :func:`default_time_step_s`); ``duration_s``: simulated
+    time (default: the approach gap / (speed · x) plus MARGIN × 2L/c of the log); ``offset_m``: the
+    distance from the first-contact point on the face at which the largest principal
+    stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
+    ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps.
+    """
+    s = scenario
+    if s.westergaard:
+        raise ValueError("westergaard=True: the reservoir's added mass on the dam is not "
+                         "modelled in stage 2")
+    if duration_s is not None and not (math.isfinite(duration_s) and duration_s > 0):
+        raise ValueError(f"duration_s={duration_s!r}: must be a finite number > 0 s")
+    t0 = time.perf_counter()
+    dt = dt_s if dt_s is not None else default_time_step_s(s)
+    problem = make_problem(s, stage1, dt)
+    t_setup = time.perf_counter() - t0
+    if duration_s is None:
+        duration_s = approach_time_s(s) + MARGIN * problem.expected_contact_s
+    impact = np.zeros(s.dim)
+    impact[-1] = s.log_front_point[-1]
+    if s.dim == 3:
+        impact[1] = s.log_front_point[1]
+    cells = stage1.mesh.cell_tags
+    materials = {T.DAM: s.concrete, T.FOUNDATION: s.rock, T.LOG: s.wood}
+    history, p_peak = [], 0.0
+
+    def stresses():
+        return stress_fields(stage1.V, problem.u, cells, materials, stage1.kind)
+
+    n = int(round(duration_s / dt))
+    if writer is not None:
+        writer.write(problem.fields() + stresses(), 0.0)
+    for i in range(n):
+        rec = problem.step()
+        if writer is not None and (i + 1) % write_every == 0:
+            writer.write(problem.fields() + stresses(), problem.t)
+        if rec.active > 0 and (i % stress_every == 0):
+            peak, _ = peak_at_offset(stresses()[1], impact, offset_m, cells, T.DAM)
+            history.append((problem.t, peak))
+            pressure = problem.fields()[2].x.array
+            p_peak = max(p_peak, comm.allreduce(float(pressure.max(initial=0.0)), op=MPI.MAX))
+    metrics = contact_metrics(problem.records, dt)
+    m_eff, v0, v1 = _log_momentum(problem)
+    return Stage2Result(problem, metrics, m_eff * (v1 - v0), m_eff, v0, v1, history, impact,
+                        offset_m, p_peak, {"setup": t_setup, "steps": time.perf_counter() - t0 - t_setup,
+                                   "dt_s": dt, "duration_s": duration_s, "steps_n": n})
+
+
+def approach_time_s(s) -> float:
+    """Time for the log to cross the gap to the face: gap / (its velocity's x component)."""
+    return s.log_gap_m / (s.log_speed_m_s * float(s.log_axis[0]))
+
+
+def _log_momentum(problem) -> tuple[float, float, float]:
+    """The log's mass (Σ M over its x DOFs, with the added mass) and its mean x velocity
+    (along the face's normal)
+    before and after, from the momenta of its nodes (M v summed over the log's x DOFs)."""
+    log = next(b for b in problem.bodies if b.name == "log")
+    ones = problem.K.createVecLeft()
+    ones.zeroEntries()
+    ones.array[log.dofs[0]] = 1.0
+    Mo = problem.K.createVecLeft()
+    problem.M.mult(ones, Mo)
+    m_eff = problem.comm.allreduce(float(Mo.array_r[log.dofs[0]].sum()), op=MPI.SUM)
+    for o in (ones, Mo):
+        o.destroy()
+    p0 = problem.momentum0["log"][0]
+    p1 = problem.records[-1].momentum["log"][0] if problem.records else p0
+    return m_eff, p0 / m_eff, p1 / m_eff
