@@ -15,7 +15,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include <cstring>
 #include <optional>
 
 namespace py = pybind11;
@@ -26,38 +25,6 @@ namespace
 using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
 using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 using RealArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-/// @brief A pair-by-pair vector (m·cols entries) as an m × cols array.
-py::array_t<double> rows_of(const Vector& v, Eigen::Index cols)
-{
-  const Eigen::Index m = cols ? v.size() / cols : 0;
-  py::array_t<double> a({static_cast<py::ssize_t>(m), static_cast<py::ssize_t>(cols)});
-  if (v.size())
-    std::memcpy(a.mutable_data(), v.data(), sizeof(double) * v.size());
-  return a;
-}
-
-py::array_t<int> states_array(const std::vector<PairState>& s)
-{
-  py::array_t<int> a(static_cast<py::ssize_t>(s.size()));
-  for (std::size_t i = 0; i < s.size(); ++i)
-    a.mutable_at(i) = static_cast<int>(s[i]);
-  return a;
-}
-
-/// @brief What a solver did, as plain Python (picklable, so it can be broadcast).
-py::dict report_dict(const SolveReport& r)
-{
-  py::dict d;
-  d["solver"] = r.solver;
-  d["converged"] = r.converged;
-  d["iterations"] = r.iterations;
-  d["state_changes"] = r.state_changes;
-  d["residual"] = r.residual;
-  d["cycled"] = r.cycled;
-  d["attempts"] = r.attempts;
-  return d;
-}
 
 py::dict step_dict(const CondensedStep& r, int dim)
 {

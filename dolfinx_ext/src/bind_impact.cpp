@@ -15,7 +15,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include <cstring>
 #include <optional>
 
 namespace py = pybind11;
@@ -25,43 +24,17 @@ namespace
 {
 using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
 
-py::array_t<double> rows(const Vector& v, Eigen::Index cols)
-{
-  const Eigen::Index m = cols ? v.size() / cols : 0;
-  py::array_t<double> a({static_cast<py::ssize_t>(m), static_cast<py::ssize_t>(cols)});
-  if (v.size())
-    std::memcpy(a.mutable_data(), v.data(), sizeof(double) * v.size());
-  return a;
-}
-
-py::dict report(const SolveReport& r)
-{
-  py::dict d;
-  d["solver"] = r.solver;
-  d["converged"] = r.converged;
-  d["iterations"] = r.iterations;
-  d["state_changes"] = r.state_changes;
-  d["residual"] = r.residual;
-  d["cycled"] = r.cycled;
-  d["attempts"] = r.attempts;
-  return d;
-}
-
 py::dict step_dict(const ImpactStep& r, int dim)
 {
   py::dict d;
-  d["impulse"] = rows(r.impulse, dim);
-  d["velocity"] = rows(r.velocity, dim);
-  d["velocity_before"] = rows(r.velocity_before, dim);
-  d["gap"] = rows(r.gap, dim);
-  py::array_t<int> states(static_cast<py::ssize_t>(r.states.size()));
+  d["impulse"] = rows_of(r.impulse, dim);
+  d["velocity"] = rows_of(r.velocity, dim);
+  d["velocity_before"] = rows_of(r.velocity_before, dim);
+  d["gap"] = rows_of(r.gap, dim);
   py::array_t<bool> active(static_cast<py::ssize_t>(r.active.size()));
-  for (std::size_t i = 0; i < r.states.size(); ++i)
-  {
-    states.mutable_at(i) = static_cast<int>(r.states[i]);
+  for (std::size_t i = 0; i < r.active.size(); ++i)
     active.mutable_at(i) = r.active[i];
-  }
-  d["states"] = states;
+  d["states"] = states_array(r.states);
   d["active"] = active;
   d["reaction"] = py::array_t<double>(r.reaction.size(), r.reaction.data());
   d["normal_impulse"] = r.normal_impulse;
@@ -73,7 +46,7 @@ py::dict step_dict(const ImpactStep& r, int dim)
   d["contact_work"] = r.contact_work;
   d["max_penetration"] = r.max_penetration;
   d["active_pairs"] = r.active_pairs;
-  d["report"] = report(r.report);
+  d["report"] = report_dict(r.report);
   return d;
 }
 } // namespace
@@ -113,7 +86,7 @@ void flexcontact::bind_impact(py::module& m)
             catch (const ConvergenceError& e)
             {
               py::object error = convergence_error(e.what());
-              error.attr("report") = report(e.report);
+              error.attr("report") = report_dict(e.report);
               PyErr_SetObject(convergence_error.ptr(), error.ptr());
               throw py::error_already_set();
             }

@@ -4,7 +4,12 @@
 /// @file bindings.h
 /// @brief Declarations of the parts of the `flexcontact._cpp` module.
 
+#include <flexcontact/problem.hpp>
+
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+
+#include <vector>
 
 namespace flexcontact
 {
@@ -19,4 +24,16 @@ void bind_condensed(pybind11::module& m);
 
 /// @brief The Moreau–Jean contact step (kernel/.../impact.hpp).
 void bind_impact(pybind11::module& m);
+
+// Conversions shared by the step bindings (bind_convert.cpp): what crosses back to Python is
+// plain NumPy and dicts, picklable so that rank 0 can broadcast it.
+
+/// @brief A pair-by-pair vector (m·cols entries) as an m × cols array.
+pybind11::array_t<double> rows_of(const Vector& v, Eigen::Index cols);
+
+/// @brief Pair states as an int array (0 open, 1 stick, 2 slip).
+pybind11::array_t<int> states_array(const std::vector<PairState>& s);
+
+/// @brief What a solver did, as a dict.
+pybind11::dict report_dict(const SolveReport& r);
 } // namespace flexcontact

@@ -1,0 +1,45 @@
+// Copyright flexcontact developers. MIT licence.
+
+/// @file bind_convert.cpp
+/// @brief Kernel results as NumPy arrays and dicts, shared by the step bindings.
+
+#include "bindings.h"
+
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+namespace py = pybind11;
+
+namespace flexcontact
+{
+py::array_t<double> rows_of(const Vector& v, Eigen::Index cols)
+{
+  const Eigen::Index m = cols ? v.size() / cols : 0;
+  py::array_t<double> a({static_cast<py::ssize_t>(m), static_cast<py::ssize_t>(cols)});
+  if (v.size())
+    std::memcpy(a.mutable_data(), v.data(), sizeof(double) * v.size());
+  return a;
+}
+
+py::array_t<int> states_array(const std::vector<PairState>& s)
+{
+  py::array_t<int> a(static_cast<py::ssize_t>(s.size()));
+  for (std::size_t i = 0; i < s.size(); ++i)
+    a.mutable_at(i) = static_cast<int>(s[i]);
+  return a;
+}
+
+py::dict report_dict(const SolveReport& r)
+{
+  py::dict d;
+  d["solver"] = r.solver;
+  d["converged"] = r.converged;
+  d["iterations"] = r.iterations;
+  d["state_changes"] = r.state_changes;
+  d["residual"] = r.residual;
+  d["cycled"] = r.cycled;
+  d["attempts"] = r.attempts;
+  return d;
+}
+} // namespace flexcontact
