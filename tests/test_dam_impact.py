@@ -97,7 +97,7 @@ def test_initial_displacement_must_live_on_V(impact):
     from flexcontact.dam.stage2 import make_problem
     s, r, _ = impact
     stage1 = solve_stage1(s, comm=COMM)
-    scalar = dolfinx.fem.Function(compat.scalar_space(stage1.mesh.msh, "CG", 1))
+    scalar = dolfinx.fem.Function(compat.scalar_space(stage1.mesh.msh, "Lagrange", 1))
     stage1.u = scalar
     with pytest.raises(ValueError, match="initial_displacement"):
         make_problem(s, stage1, r.timings_s["dt_s"])
