@@ -159,17 +159,7 @@ void flexcontact::bind_condensed(py::module& m)
                              "q = B up_c + x0 of the last step call, also a failed one")
       .def_property_readonly(
           "frames",
-          [](const CondensedContact& c)
-          {
-            const int d = c.dim();
-            py::array_t<double> a({c.pairs(), d, d});
-            auto v = a.mutable_unchecked<3>();
-            for (int k = 0; k < c.pairs(); ++k)
-              for (int i = 0; i < d; ++i)
-                for (int j = 0; j < d; ++j)
-                  v(k, i, j) = c.contact_pairs()[k].frame(i, j);
-            return a;
-          },
+          [](const CondensedContact& c) { return frames_array(c.contact_pairs(), c.dim()); },
           "Local frames T_k (m x d x d), rows n, t (, t2)")
       .def_property_readonly("contact_pairs",
                              [](const CondensedContact& c) { return c.contact_pairs(); })

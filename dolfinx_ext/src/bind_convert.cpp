@@ -30,6 +30,18 @@ py::array_t<int> states_array(const std::vector<PairState>& s)
   return a;
 }
 
+py::array_t<double> frames_array(const std::vector<ContactPair>& pairs, int dim)
+{
+  const auto m = static_cast<py::ssize_t>(pairs.size());
+  py::array_t<double> a({m, static_cast<py::ssize_t>(dim), static_cast<py::ssize_t>(dim)});
+  auto v = a.mutable_unchecked<3>();
+  for (py::ssize_t k = 0; k < m; ++k)
+    for (int i = 0; i < dim; ++i)
+      for (int j = 0; j < dim; ++j)
+        v(k, i, j) = pairs[static_cast<std::size_t>(k)].frame(i, j);
+  return a;
+}
+
 py::dict report_dict(const SolveReport& r)
 {
   py::dict d;

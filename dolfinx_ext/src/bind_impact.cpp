@@ -107,17 +107,7 @@ void flexcontact::bind_impact(py::module& m)
       .def_property_readonly("mu", [](const ImpactContact& c) { return c.mu(); })
       .def_property_readonly(
           "frames",
-          [](const ImpactContact& c)
-          {
-            const int d = c.dim();
-            py::array_t<double> a({c.pairs(), d, d});
-            auto v = a.mutable_unchecked<3>();
-            for (int k = 0; k < c.pairs(); ++k)
-              for (int i = 0; i < d; ++i)
-                for (int j = 0; j < d; ++j)
-                  v(k, i, j) = c.contact_pairs()[k].frame(i, j);
-            return a;
-          })
+          [](const ImpactContact& c) { return frames_array(c.contact_pairs(), c.dim()); })
       .def_property_readonly("restitution", &ImpactContact::restitution)
       .def_property_readonly("dt_s", &ImpactContact::dt)
       .def_property_readonly("theta", &ImpactContact::theta)

@@ -4,6 +4,7 @@
 /// @file bindings.h
 /// @brief Declarations of the parts of the `flexcontact._cpp` module.
 
+#include <flexcontact/pairs.hpp>
 #include <flexcontact/problem.hpp>
 
 #include <pybind11/numpy.h>
@@ -33,6 +34,9 @@ pybind11::array_t<double> rows_of(const Vector& v, Eigen::Index cols);
 
 /// @brief Pair states as an int array (0 open, 1 stick, 2 slip).
 pybind11::array_t<int> states_array(const std::vector<PairState>& s);
+
+/// @brief The pairs' local frames T_k as an m × d × d array (rows n, t (, t2)).
+pybind11::array_t<double> frames_array(const std::vector<ContactPair>& pairs, int dim);
 
 /// @brief What a solver did, as a dict.
 pybind11::dict report_dict(const SolveReport& r);

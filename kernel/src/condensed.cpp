@@ -4,6 +4,7 @@
 /// @brief The condensed contact problem: B, x0, W = B F* Bᵀ from pairs and F*, and one
 /// increment from u_p on the contact DOFs to λ, gap, states and contact forces.
 
+#include "constrained.hpp"
 #include "flexcontact/condensed.hpp"
 #include "python_float.hpp"
 
@@ -40,17 +41,6 @@ void check_flexibility(const Matrix& F, Eigen::Index n_c)
                                 + " (contact nodes × dim)");
   if (!F.allFinite())
     throw std::invalid_argument(who + "F* is not finite");
-}
-
-/// @brief Zeroes the rows and columns of F* that belong to constrained contact DOFs.
-void zero_constrained(Matrix& F, const std::vector<bool>& constrained)
-{
-  for (std::size_t i = 0; i < constrained.size(); ++i)
-    if (constrained[i])
-    {
-      F.row(static_cast<Eigen::Index>(i)).setZero();
-      F.col(static_cast<Eigen::Index>(i)).setZero();
-    }
 }
 
 void check_mu(const Vector& mu, std::size_t m)

@@ -5,6 +5,7 @@
 /// the velocity-level local problem on it (restitution folded into q), impulses back to the
 /// contact DOFs, and the contact terms of the energy balance.
 
+#include "constrained.hpp"
 #include "flexcontact/impact.hpp"
 #include "flexcontact/increment.hpp"
 #include "flexcontact/solvers.hpp"
@@ -52,16 +53,6 @@ void check_vector(const char* name, const Eigen::Ref<const Vector>& v, Eigen::In
                                 + " entries, expected n_c = " + std::to_string(n));
   if (!v.allFinite())
     throw std::invalid_argument(who + "step: " + name + " is not finite");
-}
-
-void zero_constrained(Matrix& F, const std::vector<bool>& constrained)
-{
-  for (std::size_t i = 0; i < constrained.size(); ++i)
-    if (constrained[i])
-    {
-      F.row(static_cast<Eigen::Index>(i)).setZero();
-      F.col(static_cast<Eigen::Index>(i)).setZero();
-    }
 }
 } // namespace
 

@@ -1,0 +1,25 @@
+// Copyright flexcontact developers. MIT licence.
+#pragma once
+
+/// @file constrained.hpp
+/// @brief Shared by the static and the impact contact objects: contact DOFs held by a
+/// Dirichlet condition do not move under contact forces.
+
+#include "flexcontact/problem.hpp"
+
+#include <vector>
+
+namespace flexcontact
+{
+/// @brief Zeroes the rows and columns of a flexibility that belong to constrained contact
+/// DOFs (K's identity rows would otherwise give them a flexibility of 1).
+inline void zero_constrained(Matrix& F, const std::vector<bool>& constrained)
+{
+  for (std::size_t i = 0; i < constrained.size(); ++i)
+    if (constrained[i])
+    {
+      F.row(static_cast<Eigen::Index>(i)).setZero();
+      F.col(static_cast<Eigen::Index>(i)).setZero();
+    }
+}
+} // namespace flexcontact
