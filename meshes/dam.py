@@ -68,8 +68,6 @@ def _model_2d(s, info):
     import gmsh
     geo = gmsh.model.geo
     pts = profile_points(s)
-    B, Lu, Ld, D = s.base_width_m, s.foundation_upstream_m, s.foundation_downstream_m, \
-        s.foundation_depth_m
     p = [geo.addPoint(x, y, 0) for x, y in pts]
     heel, toe = p[0], p[1]
     n_down = len(pts) - 2 - (1 if s.water_level_m < s.dam_height_m else 0)  # toe..crest_d
@@ -80,27 +78,35 @@ def _model_2d(s, info):
     upstream = lines[n_down + 1:]
     s_dam = geo.addPlaneSurface([geo.addCurveLoop(lines)])
 
-    f = [geo.addPoint(x, y, 0) for x, y in [(-Lu, -D), (B + Ld, -D), (B + Ld, 0), (-Lu, 0)]]
-    bottom, right = geo.addLine(f[0], f[1]), geo.addLine(f[1], f[2])
-    tail_bed, res_bed = geo.addLine(f[2], toe), geo.addLine(heel, f[3])
-    left = geo.addLine(f[3], f[0])
-    s_found = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, tail_bed, -base, res_bed,
-                                                     left])])
+    s_found, found_groups = _foundation_2d(s, geo, heel, toe, base)
     log_curves, s_log = _log_2d(s, geo)
     geo.synchronize()
 
     _gmsh.physical(2, [s_dam], DAM, NAMES[DAM])
     _gmsh.physical(2, [s_found], FOUNDATION, NAMES[FOUNDATION])
     _gmsh.physical(2, [s_log], LOG, NAMES[LOG])
-    groups = {FOUNDATION_BOTTOM: [bottom], FOUNDATION_SIDES: [left, right],
-              RESERVOIR_BED: [res_bed], TAILWATER_BED: [tail_bed], DAM_BASE: [base],
-              DAM_UPSTREAM: upstream, DAM_CREST: [crest], DAM_DOWNSTREAM: downstream,
-              **log_curves}
+    groups = {**found_groups, DAM_BASE: [base], DAM_UPSTREAM: upstream, DAM_CREST: [crest],
+              DAM_DOWNSTREAM: downstream, **log_curves}
     for tag, curves in groups.items():
         _gmsh.physical(1, curves, tag, NAMES[tag])
     _refine_near_log(s, [c for cs in log_curves.values() for c in cs], 1)
     gmsh.model.mesh.generate(2)
     return info
+
+
+def _foundation_2d(s, geo, heel, toe, base):
+    """The foundation block under the dam (sharing the base line): its surface and its
+    facet groups."""
+    B, Lu, Ld, D = s.base_width_m, s.foundation_upstream_m, s.foundation_downstream_m, \
+        s.foundation_depth_m
+    f = [geo.addPoint(x, y, 0) for x, y in [(-Lu, -D), (B + Ld, -D), (B + Ld, 0), (-Lu, 0)]]
+    bottom, right = geo.addLine(f[0], f[1]), geo.addLine(f[1], f[2])
+    tail_bed, res_bed = geo.addLine(f[2], toe), geo.addLine(heel, f[3])
+    left = geo.addLine(f[3], f[0])
+    s_found = geo.addPlaneSurface([geo.addCurveLoop([bottom, right, tail_bed, -base, res_bed,
+                                                     left])])
+    return s_found, {FOUNDATION_BOTTOM: [bottom], FOUNDATION_SIDES: [left, right],
+                     RESERVOIR_BED: [res_bed], TAILWATER_BED: [tail_bed]}
 
 
 def _log_2d(s, geo):
@@ -185,3 +191,102 @@ def _faces_3d(s, dam, found, log_vol):
     out[LOG_BACK] = [max(flat, key=ends.get)]
     out[LOG_MANTLE] = sorted(set(log_faces) - set(flat))
     return out
+
+
+# ---- the bodies apart: the dam without the log, the log in its own frame (dam/reuse.py) --
+def build_dam_only(comm, scenario, strip_m, water_levels_m=()):
+    """The dam and its foundation without the log (2D), refined along a strip of the
+    upstream face that logs can hit.
+
+    ``strip_m`` = (z0, z1): the elevations (m) bounding the strip, 0 < z0 < z1 < dam height;
+    the face has nodes there and at each of ``water_levels_m`` (and the scenario's own water
+    level), so the reservoir load is integrated exactly at those levels. Elements have the
+    size ``scenario.h_impact_m`` within ``scenario.impact_zone_m`` of the strip, growing to
+    ``scenario.h_far_m``. Tags as :func:`build` without the log's; the strip is part of
+    ``dam_upstream`` (``info["strip_m"]`` locates it). Returns (mesh, cell_tags,
+    facet_tags, info).
+    """
+    s = scenario
+    if s.dim != 2:
+        raise ValueError(f"dim={s.dim}: the dam mesh without the log is built in 2D only")
+    z0, z1 = (float(z) for z in strip_m)
+    if not 0.0 < z0 < z1 < s.dam_height_m:
+        raise ValueError(f"strip_m={(z0, z1)}: need 0 < z0 < z1 < dam_height_m="
+                         f"{s.dam_height_m}")
+    levels = sorted({float(z) for z in (*water_levels_m, s.water_level_m, z0, z1)
+                     if 0.0 < z < s.dam_height_m}, reverse=True)
+    info = dict(dim=2, base_width_m=s.base_width_m, knee_elevation_m=s.knee_elevation_m,
+                strip_m=(z0, z1), face_nodes_m=levels, h_far_m=s.h_far_m,
+                h_impact_m=s.h_impact_m)
+    return _gmsh.generate(comm, "dam2d_only", lambda: _model_dam_only_2d(s, info, levels),
+                          gdim=2)
+
+
+def _model_dam_only_2d(s, info, face_levels):
+    import gmsh
+    geo = gmsh.model.geo
+    heel, toe, knee, crest_d, crest_u = s.dam_outline()
+    down = [toe]
+    ht = s.tailwater_level_m
+    if 0 < ht < s.dam_height_m and not np.isclose(ht, knee[1]):
+        down.append((s.downstream_face_x_m(ht), ht))
+    down += [knee, crest_d]
+    down.sort(key=lambda q: q[1])
+    pts = [heel] + down + [crest_u] + [(0.0, z) for z in face_levels]
+    p = [geo.addPoint(x, y, 0) for x, y in pts]
+    lines = [geo.addLine(p[i], p[(i + 1) % len(p)]) for i in range(len(p))]
+    k = len(down)
+    upstream = lines[k + 1:]
+    s_dam = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+    s_found, found_groups = _foundation_2d(s, geo, p[0], p[1], lines[0])
+    geo.synchronize()
+    _gmsh.physical(2, [s_dam], DAM, NAMES[DAM])
+    _gmsh.physical(2, [s_found], FOUNDATION, NAMES[FOUNDATION])
+    groups = {**found_groups, DAM_BASE: [lines[0]], DAM_UPSTREAM: upstream,
+              DAM_CREST: [lines[k]], DAM_DOWNSTREAM: lines[1:k]}
+    for tag, curves in groups.items():
+        _gmsh.physical(1, curves, tag, NAMES[tag])
+    z0, z1 = info["strip_m"]
+    strip = [c for i, c in enumerate(lines[k + 1:], start=k + 1)
+             if z0 <= 0.5 * (pts[i][1] + pts[(i + 1) % len(pts)][1]) <= z1]
+    near = s.impact_zone_m
+    _gmsh.size_field(strip, 1, s.h_impact_m, s.h_far_m, near,
+                     near + 2.0 * (s.h_far_m - s.h_impact_m),
+                     points_per_curve=max(20, int(4 * (z1 - z0) / s.h_impact_m)))
+    gmsh.model.mesh.generate(2)
+    return info
+
+
+def build_log(comm, length_m, diameter_m, h_m):
+    """The 2D log (a plane-strain slab ``length_m`` × ``diameter_m``) in its own frame: axis
+    along x, centre at the origin, front end (tag ``log_front``) at x = +L/2; elements of
+    size ``h_m``. Tags: cells ``log``; facets ``log_front``, ``log_back``, ``log_upper``,
+    ``log_lower``. Returns (mesh, cell_tags, facet_tags, info)."""
+    from ._check import positive
+    L, D, h = (positive(n, v) for n, v in (("length_m", length_m), ("diameter_m", diameter_m),
+                                           ("h_m", h_m)))
+    info = dict(dim=2, length_m=L, diameter_m=D, h_m=h)
+    return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, info), gdim=2)
+
+
+def _model_log_2d(L, D, h, info):
+    import gmsh
+    geo = gmsh.model.geo
+    corners = [(-L / 2, -D / 2), (L / 2, -D / 2), (L / 2, D / 2), (-L / 2, D / 2)]
+    q = [geo.addPoint(x, y, 0) for x, y in corners]
+    lower, front = geo.addLine(q[0], q[1]), geo.addLine(q[1], q[2])
+    upper, back = geo.addLine(q[2], q[3]), geo.addLine(q[3], q[0])
+    surface = geo.addPlaneSurface([geo.addCurveLoop([lower, front, upper, back])])
+    geo.synchronize()
+    _gmsh.physical(2, [surface], LOG, NAMES[LOG])
+    for tag, c in ((LOG_LOWER, lower), (LOG_FRONT, front), (LOG_UPPER, upper),
+                   (LOG_BACK, back)):
+        _gmsh.physical(1, [c], tag, NAMES[tag])
+    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+    try:
+        gmsh.model.mesh.generate(2)
+    finally:  # gmsh's defaults again, for the next model of a session the caller opened
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
+    return info

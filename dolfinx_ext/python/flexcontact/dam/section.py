@@ -149,9 +149,25 @@ def peak_at_offset(f, point, offset_m: float, cell_tags=None, tag=None, samples:
     Stresses at a re-entrant corner or under a contact edge grow with mesh refinement; at a
     stated distance they converge, which is what a design check can use. Collective.
     """
+    msh = f.function_space.mesh
+    pts, found, cells = offset_samples(msh, point, offset_m, cell_tags, tag, samples)
+    best, where = -np.inf, None
+    if len(found):
+        vals = f.eval(pts[found], cells).reshape(-1)
+        i = int(np.argmax(vals))
+        best, where = float(vals[i]), pts[found[i]]
+    everyone = msh.comm.allgather((best, where))
+    best, where = max(everyone, key=lambda bw: bw[0])
+    return (best, where) if np.isfinite(best) else (float("nan"), None)
+
+
+def offset_samples(msh, point, offset_m: float, cell_tags=None, tag=None, samples: int = 720):
+    """The sample points of :func:`peak_at_offset` (``samples`` on the circle in 2D, four
+    times as many on the sphere in 3D, of radius ``offset_m`` around ``point``): all the
+    points (n, 3), the indices of those in this rank's cells (tagged ``tag`` if given) and
+    their cells."""
     if not offset_m > 0:
         raise ValueError(f"offset_m={offset_m!r}: must be > 0")
-    msh = f.function_space.mesh
     gdim = msh.geometry.dim
     pts = np.zeros((samples if gdim == 2 else 4 * samples, 3))
     dirs = sample_directions(gdim, pts.shape[0])
@@ -163,11 +179,12 @@ def peak_at_offset(f, point, offset_m: float, cell_tags=None, tag=None, samples:
         mark[cell_tags.indices[cell_tags.values == tag]] = True
         keep = mark[cells]
         found, cells = found[keep], cells[keep]
-    best, where = -np.inf, None
-    if len(found):
-        vals = f.eval(pts[found], cells).reshape(-1)
-        i = int(np.argmax(vals))
-        best, where = float(vals[i]), pts[found[i]]
-    everyone = msh.comm.allgather((best, where))
-    best, where = max(everyone, key=lambda bw: bw[0])
-    return (best, where) if np.isfinite(best) else (float("nan"), None)
+    return pts, found, cells
+
+
+def offset_sample_cells(msh, point, offset_m: float, cell_tags=None, tag=None,
+                        samples: int = 720) -> np.ndarray:
+    """The distinct cells holding the samples of :func:`peak_at_offset`: for a cell-wise
+    constant field its peak at the offset is the largest value over these cells."""
+    _, _, cells = offset_samples(msh, point, offset_m, cell_tags, tag, samples)
+    return np.unique(cells).astype(np.int32)
