@@ -1,0 +1,292 @@
+"""The dam and its foundation alone, factored once for a whole sweep of impacts.
+
+DESIGN.md §1 (per-body condensation): the dam is linear and touches the log only through
+contact, so everything it contributes to an impact scenario comes from two factorizations
+made once per dam mesh:
+
+* stage 1: K (stage-1 supports) is factored once; a water level is a new right-hand side,
+  one back-substitution (the static displacement and base section are cached per level);
+* stage 2: Ŵ = M + hθC + h²θ²K at the sweep's time step, factored once, and its condensed
+  flexibility W_face = S Ŵ⁻¹ Sᵀ on every DOF of the face strip's nodes (``_cpp.flexibility``,
+  the same call as Condensation), dense.
+
+During an impact the dam's state is split as u = u_static + w: u_static is the stage-1
+equilibrium under the constant loads, so w (and its velocity) obey the homogeneous
+equations driven by the contact impulses alone. Before the first impulse w = 0 and the free
+velocity is exactly zero: no back-substitution is needed then.
+
+Outputs: the linearised heel stress is σ_static + g·w with g = −K_dam c (c: the section's
+heel-stress coefficients of nodal forces at the base nodes, K_dam the stiffness of the dam's
+cells alone), i.e. the section of the dam's internal nodal forces; the largest principal
+stress near the impact point is evaluated on the cells sampled at the stated offset.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+import dolfinx.fem.petsc  # noqa: F401  (the submodule must be imported explicitly in 0.5)
+import dolfinx.mesh
+
+from .. import _cpp, compat
+from .. import impact_setup as setup
+from ..assembly import assemble_load, assemble_stiffness
+from ..forms import elasticity_form, lame_fields, mass_form, max_principal_stress
+from ..meshes import dam as dam_mesh
+from ..meshes import dam_tags as T
+from ..pairing import _candidate_surface
+from .section import BaseSection, offset_sample_cells
+from .stage1 import DamMesh, _measures, _sections, body_loads
+from .stage2 import stage2_supports
+
+STRIP = 1
+"""Tag of the face-strip facets in the DamModel's own strip MeshTags."""
+
+
+@dataclass
+class StaticState:
+    """Stage 1 at one water level: displacement (Function, m), the base section from the
+    dam's side (with uplift) and the hand statics of that level."""
+
+    water_level_m: float
+    u: Any
+    section: BaseSection
+    section_foundation: BaseSection
+
+
+def default_strip_m(base, water_levels_m, pitch_deg: float = 15.0,
+                    margin_m: float = 1.0) -> tuple[float, float]:
+    """Elevations (m) of the face strip that the front end of the base scenario's log can
+    hit at any water level of the range and any pitch up to ± max(|its pitch|,
+    ``pitch_deg``), widened by ``margin_m`` each side and kept on the face."""
+    pitch = np.radians(max(abs(base.log_pitch_deg), pitch_deg))
+    R, L = base.log_radius_m, base.log_length_m
+    reach = 0.5 * L * np.sin(pitch) + R * np.cos(pitch)
+    axis_lo = min(water_levels_m) - base.log_draft_m + R
+    axis_hi = max(water_levels_m) - base.log_draft_m + R
+    z0 = max(axis_lo - reach - margin_m, 0.5 * base.h_far_m)
+    z1 = min(axis_hi + reach + margin_m, base.dam_height_m)
+    return float(z0), float(z1)
+
+
+class DamModel:
+    """The dam + foundation of ``base`` (without the log), factored for a sweep at
+    ``dt_s``; see the module docstring. ``water_levels_m`` = (lo, hi): the range of water
+    levels of the sweep (the face has nodes at both). Serial (``comm`` of one rank).
+
+    Counters: ``factorizations`` and ``back_substitutions``, dicts by stage.
+    """
+
+    def __init__(self, base, dt_s: float, water_levels_m=None, comm=MPI.COMM_SELF,
+                 strip_m=None, theta: float = 0.5):
+        if comm.size != 1:
+            raise ValueError(f"comm of size {comm.size}: DamModel is serial (one rank; "
+                             "parallel sweeps run one DamModel per process)")
+        setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
+        lo, hi = _levels(base, water_levels_m)
+        self.base, self.dt, self.theta, self.comm = base, float(dt_s), float(theta), comm
+        self.water_levels_m = (lo, hi)
+        self.strip_m = tuple(strip_m) if strip_m is not None else default_strip_m(base, (lo, hi))
+        self.factorizations = {"dam_stage1": 0, "dam_stage2": 0}
+        self.back_substitutions = {"dam_stage1": 0, "dam_stage2": 0}
+        self.timings = {}
+        t0 = time.perf_counter()
+        self.mesh = DamMesh(*dam_mesh.build_dam_only(comm, base, self.strip_m, (lo, hi)))
+        self.timings["mesh_s"] = time.perf_counter() - t0
+        self.V = compat.vector_space(self.mesh.msh)
+        self.kind = "plane_strain"
+        self.materials = {T.DAM: base.concrete, T.FOUNDATION: base.rock}
+        self.bcs = stage2_supports(base, self.V, self.mesh)
+        self._statics: dict = {}
+        self._stage1()
+        self._stage2()
+        self._heel_functional()
+        self._stress_expression()
+        self.timings["setup_s"] = time.perf_counter() - t0
+
+    # ---- stage 1 -------------------------------------------------------------------------
+    def _stage1(self):
+        t0 = time.perf_counter()
+        u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        self.dx, self.ds = _measures(self.mesh)
+        self.a_form = dolfinx.fem.form(elasticity_form(u, v, self.materials, self.dx, self.kind,
+                                                       cell_tags=self.mesh.cell_tags))
+        K1 = assemble_stiffness(self.a_form, self.bcs)
+        ksp = PETSc.KSP().create(K1.getComm())
+        ksp.setOperators(K1)
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+        ksp.setUp()  # the one numerical factorization of K
+        self.factorizations["dam_stage1"] += 1
+        self._K1, self._ksp1 = K1, ksp
+        self.timings["stage1_factor_s"] = time.perf_counter() - t0
+
+    def static_state(self, water_level_m: float) -> StaticState:
+        """Stage 1 at ``water_level_m`` (cached): one back-substitution with K's factor."""
+        key = float(water_level_m)
+        if key in self._statics:
+            return self._statics[key]
+        s = self.base.replace(water_level_m=key)
+        v = ufl.TestFunction(self.V)
+        loads = body_loads(s, v, self.dx, self.ds)
+        p = assemble_load(self.V, self.a_form, dolfinx.fem.form(loads["dam"] + loads["foundation"]),
+                          self.bcs, self.comm)
+        uh = dolfinx.fem.Function(self.V, name="displacement_m")
+        x = compat.petsc_vec(uh)
+        self._ksp1.solve(p, x)
+        if self._ksp1.getConvergedReason() < 0:
+            raise RuntimeError(f"stage 1 at water_level_m={key}: the MUMPS solve failed")
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        p.destroy()
+        self.back_substitutions["dam_stage1"] += 1
+        dam, found = _sections(s, self.V, uh, loads, self.dx, self.kind, self.mesh)
+        state = StaticState(key, uh, dam, found)
+        self._statics[key] = state
+        return state
+
+    # ---- stage 2 -------------------------------------------------------------------------
+    def _stage2(self):
+        t0 = time.perf_counter()
+        u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        m_form = dolfinx.fem.form(mass_form(u, v, self.materials, self.dx))
+        marker = setup.held_marker(self._K1, self.bcs)
+        self.K, self.M = setup.assemble_matrices(self.a_form, m_form, self.bcs, "consistent",
+                                                 marker)
+        self.W_hat = setup.iteration_matrix(self.K, self.M, self.dt, self.theta, (0.0, 0.0),
+                                            marker)
+        marker.destroy()
+        self.strip_tags = self._strip_tags()
+        self.face = _candidate_surface(self.V, self.strip_tags, STRIP)
+        self.face_dofs = np.asarray(self.face["dofs"], np.int64).reshape(-1)
+        F, self.factor, info = _cpp.flexibility(self.W_hat, self.face_dofs, "schur")
+        self.W_face = np.asarray(F)
+        self.factorizations["dam_stage2"] += int(info["factorizations"])
+        self.flex_info = dict(info)
+        self.timings["stage2_factor_s"] = time.perf_counter() - t0
+
+    def _strip_tags(self):
+        """MeshTags of the upstream-face facets inside the strip (their midpoints)."""
+        msh, ft = self.mesh.msh, self.mesh.facet_tags
+        fdim = msh.topology.dim - 1
+        up = np.sort(ft.indices[ft.values == T.DAM_UPSTREAM]).astype(np.int32)
+        mid = dolfinx.mesh.compute_midpoints(msh, fdim, up)[:, msh.geometry.dim - 1]
+        z0, z1 = self.strip_m
+        tol = 1e-9 * self.base.dam_height_m
+        inside = up[(mid >= z0 - tol) & (mid <= z1 + tol)]
+        return dolfinx.mesh.meshtags(msh, fdim, inside, np.full(inside.size, STRIP, np.int32))
+
+    def new_vector(self) -> PETSc.Vec:
+        x = self.K.createVecLeft()
+        x.zeroEntries()
+        return x
+
+    def free_velocity(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
+        """v_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)] (one back-substitution)."""
+        h = self.dt
+        y = w.copy()
+        y.axpy(h * self.theta, omega)
+        r = self.new_vector()
+        self.K.mult(y, r)
+        r.scale(-h)
+        out = self.new_vector()
+        self.factor.solve(r, out)
+        self.back_substitutions["dam_stage2"] += 1
+        out.axpy(1.0, omega)
+        for o in (y, r):
+            o.destroy()
+        return out
+
+    def correction(self, r_face: np.ndarray) -> PETSc.Vec:
+        """Ŵ⁻¹ Sᵀ r: the velocity change from the contact impulses ``r_face`` (N·s) on the
+        strip's DOFs (one back-substitution)."""
+        r = self.new_vector()
+        r.setValues(self.face_dofs.astype(PETSc.IntType), r_face, addv=PETSc.InsertMode.ADD_VALUES)
+        r.assemble()
+        dv = self.new_vector()
+        self.factor.solve(r, dv)
+        self.back_substitutions["dam_stage2"] += 1
+        r.destroy()
+        return dv
+
+    # ---- outputs -------------------------------------------------------------------------
+    def _heel_functional(self):
+        """g with σ_heel(w) − σ_heel(0) = g·w: the heel stress of the dam's internal nodal
+        forces −K_dam w at the base nodes (linear in w)."""
+        s, V, msh = self.base, self.V, self.mesh.msh
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        a_dam = dolfinx.fem.form(elasticity_form(u, v, s.concrete, self.dx(T.DAM), self.kind))
+        K_dam = dolfinx.fem.petsc.assemble_matrix(a_dam)
+        K_dam.assemble()
+        ft = self.mesh.facet_tags
+        blocks = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim - 1,
+                                                     ft.indices[ft.values == T.DAM_BASE])
+        pts = V.tabulate_dof_coordinates()[blocks, :s.dim]
+        B, width = s.base_width_m, 1.0
+        c = K_dam.createVecRight()
+        c.zeroEntries()
+        for k in range(s.dim):
+            unit = np.zeros((len(blocks), s.dim))
+            unit[:, k] = 1.0
+            coeff = [BaseSection.from_forces(p[None, :], f[None, :], B, width).sigma_heel_Pa
+                     for p, f in zip(pts, unit)]
+            c.array[blocks * s.dim + k] = coeff
+        g = K_dam.createVecLeft()
+        K_dam.mult(c, g)
+        self.heel_gradient = -g.array_r.copy()
+        for o in (K_dam, c, g):
+            o.destroy()
+
+    def heel_stress_Pa(self, static: StaticState, w: Optional[PETSc.Vec]) -> float:
+        """Linearised heel stress (Pa, tension positive) of the state u_static + w."""
+        sigma = static.section.sigma_heel_Pa
+        return sigma if w is None else sigma + float(self.heel_gradient @ w.array_r)
+
+    def _stress_expression(self):
+        msh = self.mesh.msh
+        lame = lame_fields(msh, self.mesh.cell_tags, self.materials)
+        self._u_total = dolfinx.fem.Function(self.V)
+        V0 = compat.scalar_space(msh, "DG", 0)
+        self._principal = dolfinx.fem.Expression(
+            max_principal_stress(self._u_total, lame, self.kind), compat.interpolation_points(V0))
+
+    def stress_cells(self, point_m, offset_m: float) -> np.ndarray:
+        """The dam's cells sampled at ``offset_m`` from ``point_m`` (see peak_at_offset)."""
+        return offset_sample_cells(self.mesh.msh, point_m, offset_m, self.mesh.cell_tags, T.DAM)
+
+    def peak_principal_Pa(self, static: StaticState, w: PETSc.Vec, cells: np.ndarray) -> float:
+        """Largest principal stress (Pa) of u_static + w over ``cells`` (DG0: exact)."""
+        if cells.size == 0:
+            return float("nan")
+        n = w.getLocalSize()
+        self._u_total.x.array[:n] = static.u.x.array[:n] + w.array_r
+        self._u_total.x.scatter_forward()
+        vals = compat.eval_expression(self._principal, self.mesh.msh, cells)
+        return float(np.max(vals))
+
+    def counts(self) -> dict:
+        return {"factorizations": dict(self.factorizations),
+                "back_substitutions": dict(self.back_substitutions)}
+
+
+def _levels(base, water_levels_m) -> tuple[float, float]:
+    """The checked (lo, hi) water-level range (m); the base's level when None."""
+    if water_levels_m is None:
+        return float(base.water_level_m), float(base.water_level_m)
+    try:
+        lo, hi = (float(z) for z in water_levels_m)
+    except (TypeError, ValueError):
+        raise ValueError(f"water_levels_m={water_levels_m!r}: give (lowest, highest) in m")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi <= base.dam_height_m):
+        raise ValueError(f"water_levels_m={water_levels_m!r}: need 0 < lowest <= highest <= "
+                         f"dam_height_m={base.dam_height_m}")
+    for z in (lo, hi):
+        base.replace(water_level_m=z)  # the log must float at both ends (checked there)
+    return lo, hi

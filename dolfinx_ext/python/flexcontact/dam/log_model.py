@@ -1,0 +1,164 @@
+"""The log alone in its own frame, factored once per log geometry and material.
+
+The log (a 2D plane-strain slab L × D, axis along x, centre at the origin, front end at
+x = +L/2) is meshed once; its iteration matrix Ŵ = M + (hθ)²K (no support: Ŵ is regular
+where K is not) is factored once and condensed on the front end's nodes. A scenario with
+the same log but another pitch, water level, speed or friction only places it: a rigid
+rotation R (the pitch) and a translation. Positions and velocities rotate by R per node,
+the flexibility blockwise, W_global = R W_local Rᵀ (Ŵ is isotropic: rotating the body
+rotates its operators).
+
+During an impact the log's displacement is split as u = V₀ t + w with V₀ its rigid approach
+velocity: K V₀ = 0, so w and its velocity ω obey the homogeneous equations driven by the
+contact impulses; before the first impulse ω = w = 0 and no back-substitution is needed.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx.fem
+
+from .. import _cpp, compat
+from .. import impact_setup as setup
+from ..forms import Material, elasticity_form, mass_form
+from ..meshes import dam as dam_mesh
+from ..meshes import dam_tags as T
+from ..pairing import _candidate_surface
+
+
+def rotation(pitch_deg: float) -> np.ndarray:
+    """2×2 rotation taking the log's local x axis to its axis in the dam's frame (front
+    end up for a positive pitch)."""
+    t = math.radians(pitch_deg)
+    return np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+
+
+def rotate_blocks(W: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """R W Rᵀ blockwise: every d×d node block W_ij → R W_ij Rᵀ (W node-major)."""
+    d = R.shape[0]
+    n = W.shape[0] // d
+    Wb = W.reshape(n, d, n, d)
+    return np.einsum("ab,ibjc,dc->iajd", R, Wb, R).reshape(W.shape)
+
+
+class LogModel:
+    """One log geometry and material at the time step ``dt_s``, factored once.
+
+    ``rho_effective_kg_m3``: the wood's density with the added mass of the water,
+    ρ (1 + C_a); ``E``, ``nu``: the wood's along-grain modulus (Pa) and Poisson's ratio;
+    ``h_m``: element size (default D/4). Serial.
+    """
+
+    def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
+                 E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
+                 comm=MPI.COMM_SELF):
+        if comm.size != 1:
+            raise ValueError(f"comm of size {comm.size}: LogModel is serial (one rank)")
+        setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
+        self.material = Material(E_Pa=E, nu=nu, rho_kg_m3=rho_effective_kg_m3,
+                                 name="wood+added mass")
+        self.length_m, self.diameter_m = float(length_m), float(diameter_m)
+        self.dt, self.theta = float(dt_s), float(theta)
+        self.factorizations, self.back_substitutions = 0, 0
+        t0 = time.perf_counter()
+        h = h_m if h_m is not None else diameter_m / 4
+        self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(comm, length_m,
+                                                                         diameter_m, h)
+        self.V = compat.vector_space(self.msh)
+        self._factor()
+        self.front = _candidate_surface(self.V, self.facet_tags, T.LOG_FRONT)
+        self.front_dofs = np.asarray(self.front["dofs"], np.int64).reshape(-1)
+        F, self.factor, info = _cpp.flexibility(self.W_hat, self.front_dofs, "schur")
+        self.W_front = np.asarray(F)
+        self.factorizations += int(info["factorizations"])
+        self.setup_s = time.perf_counter() - t0
+
+    def _factor(self):
+        V, mat = self.V, self.material
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        dx = ufl.Measure("dx", domain=self.msh)
+        a = dolfinx.fem.form(elasticity_form(u, v, mat, dx, "plane_strain"))
+        m = dolfinx.fem.form(mass_form(u, v, mat.rho_kg_m3, dx))
+        marker = self.new_vector()
+        marker.set(1.0)
+        self.K, self.M = setup.assemble_matrices(a, m, [], "consistent", marker)
+        self.W_hat = setup.iteration_matrix(self.K, self.M, self.dt, self.theta, (0.0, 0.0),
+                                            marker)
+        ones = [self.new_vector() for _ in range(2)]
+        for k, o in enumerate(ones):
+            o.array[k::2] = 1.0
+        Mo = self.new_vector()
+        self.M.mult(ones[0], Mo)
+        self.mass_kg_per_m = float(Mo.sum())  # Σ M over the x DOFs: the log's mass
+        self._rigid = ones
+        for o in (marker, Mo):
+            o.destroy()
+        self.x_nodes = V.tabulate_dof_coordinates()[:, :2].copy()
+
+    def new_vector(self) -> PETSc.Vec:
+        if hasattr(self, "K"):
+            x = self.K.createVecLeft()
+        else:
+            n = self.V.dofmap.index_map.size_local * self.V.dofmap.index_map_bs
+            x = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
+        x.zeroEntries()
+        return x
+
+    def placed_front(self, R: np.ndarray, centre: np.ndarray) -> dict:
+        """The front end's surface dict (surface_nodes layout) placed in the dam's frame."""
+        f = dict(self.front)
+        f["x"] = np.asarray(centre)[None, :] + np.asarray(self.front["x"]) @ R.T
+        f["normal"] = np.asarray(self.front["normal"]) @ R.T
+        if "facet_normal" in f:
+            f["facet_normal"] = np.asarray(self.front["facet_normal"]) @ R.T
+        return f
+
+    def W_front_global(self, R: np.ndarray) -> np.ndarray:
+        return rotate_blocks(self.W_front, R)
+
+    def free_velocity(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
+        """ω_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)] (one back-substitution), local frame."""
+        h = self.dt
+        y = w.copy()
+        y.axpy(h * self.theta, omega)
+        r = self.new_vector()
+        self.K.mult(y, r)
+        r.scale(-h)
+        out = self.new_vector()
+        self.factor.solve(r, out)
+        self.back_substitutions += 1
+        out.axpy(1.0, omega)
+        for o in (y, r):
+            o.destroy()
+        return out
+
+    def correction(self, r_front_local: np.ndarray) -> PETSc.Vec:
+        """Ŵ⁻¹ Sᵀ r for impulses (N·s, local frame) on the front end's DOFs."""
+        r = self.new_vector()
+        r.array[self.front_dofs] = r_front_local
+        dv = self.new_vector()
+        self.factor.solve(r, dv)
+        self.back_substitutions += 1
+        r.destroy()
+        return dv
+
+    def momentum_local(self, omega: PETSc.Vec) -> np.ndarray:
+        """Σ (M ω) per local component (N·s/m): the momentum of the velocity ω."""
+        Mw = self.new_vector()
+        self.M.mult(omega, Mw)
+        out = np.array([Mw.dot(o) for o in self._rigid])
+        Mw.destroy()
+        return out
+
+    def rotation_rad(self, w: PETSc.Vec) -> float:
+        """The rigid rotation (rad, counter-clockwise) best fitting the displacement w:
+        Σ x × w / Σ |x|² about the log's centre."""
+        x = self.x_nodes
+        wv = w.array_r.reshape(-1, 2)
+        return float(np.sum(x[:, 0] * wv[:, 1] - x[:, 1] * wv[:, 0]) / np.sum(x * x))

@@ -1,0 +1,146 @@
+"""Many impact scenarios on one dam for the price of its factorizations (issue: the sweep).
+
+Stage 2 (stage2.py) meshes the dam, its foundation and the log together and factors the
+whole iteration matrix for every scenario. Here the bodies are apart (DESIGN.md §1,
+per-body condensation; they touch only through contact):
+
+* :class:`~flexcontact.dam.dam_model.DamModel`: the dam + foundation without the log, with
+  stage 1's K factored once (a water level is one back-substitution) and stage 2's Ŵ
+  factored once at the sweep's time step, condensed on the face strip logs can hit;
+* :class:`~flexcontact.dam.log_model.LogModel`: one log geometry and material in its own
+  frame, factored once and cached; a scenario only places it (rotation + translation);
+* :func:`~flexcontact.dam.coupled_step.run_impact`: the Moreau–Jean steps of one scenario
+  with the kernel's ``ImpactContact`` on the block-diagonal flexibility [W_log, W_face].
+
+:class:`ScenarioEvaluator` is what a sweep calls: ``evaluate(scenario) -> dict`` of plain
+floats, ``counts()`` of factorizations and back-substitutions per body. One time step
+serves the whole sweep (:func:`sweep_time_step_s`). 2D only.
+"""
+from __future__ import annotations
+
+import time
+from typing import Iterable
+
+from mpi4py import MPI
+
+from .. import impact_setup as setup
+from .coupled_step import expected_contact_s, run_impact
+from .dam_model import DamModel
+from .log_model import LogModel
+from .stage2 import default_time_step_s
+
+DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
+                  "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
+                  "tailwater_level_m", "uplift_factor", "westergaard", "concrete", "rock",
+                  "water_density_kg_m3", "gravity_m_s2", "mesh_size_far_m",
+                  "mesh_size_impact_m", "impact_zone_m", "refine")
+"""Parameters fixed by the dam's factorizations: a scenario must share them with the base."""
+
+
+def sweep_time_step_s(scenarios: Iterable) -> float:
+    """One time step (s) for every scenario: the smallest of stage 2's default steps
+    (the log's first wave round trip along x over 40 steps), so that the most demanding
+    scenario (the shortest log round trip) is resolved as a single run would resolve it.
+    The speed does not enter: an elastic impact lasts 2L/c whatever the speed."""
+    steps = [default_time_step_s(s) for s in scenarios]
+    if not steps:
+        raise ValueError("scenarios: empty; give at least one scenario to choose dt_s from")
+    return min(steps)
+
+
+def check_same_dam(base, scenario) -> None:
+    """ValueError naming the first dam parameter in which ``scenario`` differs from
+    ``base`` (those need another DamModel)."""
+    for name in DAM_PARAMETERS:
+        a, b = getattr(base, name), getattr(scenario, name)
+        if a != b:
+            raise ValueError(f"{name}={b!r} differs from the dam being reused ({name}={a!r}); "
+                             "a scenario may change only the log, its speed and angles, the "
+                             "friction and the water level")
+
+
+def log_key(s) -> tuple:
+    """What a LogModel depends on: length, diameter, density, added-mass coefficient, E, ν."""
+    return (s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3, s.added_mass_coefficient,
+            s.wood.E_Pa, s.wood.nu)
+
+
+class ScenarioEvaluator:
+    """Evaluate impact scenarios of one dam (that of ``base``) cheaply.
+
+    ``dt_s``: the sweep's time step (default: :func:`sweep_time_step_s` of ``[base]``);
+    ``water_levels_m``: (lowest, highest) water level of the sweep (default: the base's);
+    ``comm``: one rank (a parallel sweep runs one evaluator per process); ``strip_m``:
+    the elevations of the face strip (default: dam_model.default_strip_m); ``offset_m``:
+    the distance from the first-contact point at which the peak principal stress is read.
+    """
+
+    def __init__(self, base, dt_s: float | None = None, water_levels_m=None,
+                 comm=MPI.COMM_SELF, *, strip_m=None, offset_m: float = 1.0):
+        if base.dim != 2:
+            raise ValueError(f"dim={base.dim}: the scenario evaluator is 2D only")
+        if base.westergaard:
+            raise ValueError("westergaard=True: the reservoir's added mass on the dam is not "
+                             "modelled in stage 2")
+        if not offset_m > 0:
+            raise ValueError(f"offset_m={offset_m!r}: must be > 0 m")
+        self.base, self.offset_m = base, float(offset_m)
+        self.dt = float(dt_s) if dt_s is not None else sweep_time_step_s([base])
+        t0 = time.perf_counter()
+        self.dam = DamModel(base, self.dt, water_levels_m, comm, strip_m=strip_m)
+        self.dam.static_state(base.water_level_m)
+        self._logs: dict = {}
+        self.setup_s = time.perf_counter() - t0
+
+    def check(self, scenario) -> None:
+        """ValueError naming the parameter if ``scenario`` cannot reuse this dam."""
+        check_same_dam(self.base, scenario)
+        lo, hi = self.dam.water_levels_m
+        if not lo <= scenario.water_level_m <= hi:
+            raise ValueError(f"water_level_m={scenario.water_level_m!r}: outside the range "
+                             f"{(lo, hi)} the dam was built for (water_levels_m)")
+        setup.check_resolution(self.dt, expected_contact_s(scenario, self.dam),
+                               "2L/c of the log along the face normal")
+        z0, z1 = self.dam.strip_m
+        front = scenario.log_centre[-1] + 0.5 * scenario.log_length_m * scenario.log_axis[-1]
+        reach = scenario.log_radius_m * abs(scenario.log_axis[0])
+        if not (z0 <= front - reach and front + reach <= z1):
+            raise ValueError(
+                f"log_pitch_deg={scenario.log_pitch_deg!r}, water_level_m="
+                f"{scenario.water_level_m!r}: the log's front end (elevations "
+                f"{front - reach:.3f}..{front + reach:.3f} m) leaves the face strip "
+                f"{z0:.3f}..{z1:.3f} m of this dam (strip_m)")
+
+    def log_model(self, s) -> LogModel:
+        """The cached LogModel of the scenario's log (made on first use)."""
+        key = log_key(s)
+        if key not in self._logs:
+            self._logs[key] = LogModel(
+                s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
+                s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm)
+        return self._logs[key]
+
+    def evaluate(self, scenario) -> dict:
+        """The outputs of one scenario (plain floats): peak_force_N_per_m,
+        contact_duration_s, impulse_N_s_per_m, log_momentum_change_N_s_per_m (along x,
+        negative: the log is slowed), heel_stress_static_Pa, heel_stress_impact_Pa (most
+        tensile linearised heel stress from the first impulse to the end of the run),
+        peak_tensile_stress_Pa (largest principal stress at ``offset_m`` from the
+        first-contact point, peak over the steps in contact), peak_contact_pressure_Pa,
+        log_rotation_rad (the log's rigid rotation at the end), steps, and a few more."""
+        self.check(scenario)
+        log = self.log_model(scenario)
+        static = self.dam.static_state(scenario.water_level_m)
+        t0 = time.perf_counter()
+        out = run_impact(self.dam, log, scenario, static, self.offset_m)
+        out["evaluate_s"] = time.perf_counter() - t0
+        return out
+
+    def counts(self) -> dict:
+        """{"factorizations": {"dam_stage1", "dam_stage2", "log"}, "back_substitutions":
+        {same keys}}; "log" sums over the cached log models."""
+        c = self.dam.counts()
+        logs = list(self._logs.values())
+        c["factorizations"]["log"] = sum(m.factorizations for m in logs)
+        c["back_substitutions"]["log"] = sum(m.back_substitutions for m in logs)
+        return c
