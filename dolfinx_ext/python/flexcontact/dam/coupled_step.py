@@ -83,6 +83,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
     duration = approach_time_s(s) + MARGIN * expected_contact_s(s, dam)
     n = int(round(duration / h))
     records, heel, peak_principal, p_peak = [], -math.inf, -math.inf, 0.0
+    solves0 = (dam.back_substitutions["dam_stage2"], log.back_substitutions)
     for i in range(n):
         t = i * h
         vf_d, vf_l = bd.free(), bl.free()
@@ -108,8 +109,11 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
         if active > 0:
             peak_principal = max(peak_principal, dam.peak_principal_Pa(static, bd.w, cells))
             p_peak = max(p_peak, _peak_pressure(out, pairs, h))
-    return _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,
-                    offset_m, n)
+    out = _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,
+                   offset_m, n)
+    out["dam_back_substitutions"] = dam.back_substitutions["dam_stage2"] - solves0[0]
+    out["log_back_substitutions"] = log.back_substitutions - solves0[1]
+    return out
 
 
 def _log_values(log, vec, R, rigid) -> np.ndarray:
