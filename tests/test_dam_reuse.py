@@ -145,3 +145,40 @@ def test_another_dam_is_named_before_computing(evaluator):
         evaluator.evaluate(BASE.replace(water_level_m=LEVELS[0] - 1.0))
     with pytest.raises(ValueError, match="log_pitch_deg"):
         evaluator.evaluate(BASE.replace(log_pitch_deg=60.0))
+
+
+MPI_SCRIPT = '''
+import json, sys
+from mpi4py import MPI
+from flexcontact.dam import DamScenario
+from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
+base = DamScenario(mesh_size_far_m=6.0, mesh_size_impact_m=0.4)
+levels = (base.water_level_m - 1.0, base.water_level_m)
+try:
+    ScenarioEvaluator(base, comm=MPI.COMM_WORLD)
+    refused = ""
+except ValueError as e:
+    refused = str(e)
+ev = ScenarioEvaluator(base, sweep_time_step_s([base]), levels, MPI.COMM_SELF)
+out = ev.evaluate(base)
+got = MPI.COMM_WORLD.gather((refused, out), root=0)
+if MPI.COMM_WORLD.rank == 0:
+    print("RESULT" + json.dumps(got))
+'''
+
+
+def test_each_rank_evaluates_alone_with_the_serial_answer(both, tmp_path):
+    """Under mpirun every process runs its own evaluator (COMM_SELF) and gets the serial
+    answer; a communicator of two ranks is refused by name."""
+    import json
+    from conftest import mpirun
+    script = tmp_path / "ranks.py"
+    script.write_text(MPI_SCRIPT)
+    text = mpirun(2, script, timeout=900).stdout
+    ranks = json.loads(text.split("RESULT", 1)[1])
+    serial, _, _ = both
+    for refused, out in ranks:
+        assert "comm" in refused, refused
+        for key in ("peak_force_N_per_m", "impulse_N_s_per_m", "contact_duration_s",
+                    "heel_stress_impact_Pa", "peak_tensile_stress_Pa"):
+            assert abs(out[key] - serial[key]) <= 1e-9 * abs(serial[key]), (key, out, serial)
