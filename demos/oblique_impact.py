@@ -132,7 +132,6 @@ def summarise(case, problem, records, v_n, v_t):
         "threshold_ratio": 3 * args.mu * (1 + e_eff),
         "tangential_ratio": -J[0] / J[1], "tangential_ratio_ref": args.mu,
         "tangential_impulse_rigid_stick": mass * v_t / 3,
-        "normal_impulse_rigid": mass * (1 + e_eff) * v_n,
         "slip_steps": sum(1 for r in in_contact if r.stick == 0),
         "stick_steps": sum(1 for r in in_contact if r.stick > 0),
         "pairings": problem.pairings, "factorizations": problem.factorizations,

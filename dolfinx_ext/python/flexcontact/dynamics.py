@@ -74,7 +74,8 @@ class ImpactProblem:
     materials : ``{cell_tag: forms.Material}``; every body needs E and a density > 0.
     bcs : Dirichlet conditions (zero values: fixed supports). A body whose nodes are all
         held is rigid: contact DOFs held by a condition get no flexibility.
-    contact : one ContactInterface or a list of them (node–node pairs).
+    contact : one ContactInterface or a list of them (node–node or node–surface pairs; no
+        rigid targets).
     dt_s : time step h [s], checked against the expected contact duration (at least
         ``setup.MIN_STEPS_IN_CONTACT`` steps), estimated as the shortest 2L/c of the
         bodies along the contact normal unless ``expected_contact_s`` is given.
@@ -89,6 +90,12 @@ class ImpactProblem:
     initial_displacement : a Function on V (m) to start from, e.g. a static state under
         ``loads`` (zeroed at held DOFs); None: zero. Its strain energy is the initial one.
     solver, flexibility : as for ContactProblem.
+
+    Node–surface pairs are re-made before every step but the first (``repair``: B, x0 and
+    W_eff from the stored F̂, no factorization; ``pairings`` counts them).
+    ``set_time_step`` changes h (one new factorization; ``factorizations`` counts them).
+    ``energy`` is the step-by-step energy account (energy.py), ``records`` one
+    ImpactStepRecord per step.
     """
 
     def __init__(self, V, cell_tags: MeshTags, bodies: dict[str, int], materials: dict,
