@@ -29,8 +29,8 @@ from .tools import surface_nodes
 
 from .tags import (BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y,  # noqa: F401
                    UPPER)
-from . import bar_impact, block_on_base, hertz2d, hertz3d, patch  # noqa: E402,F401
+from . import bar_impact, block_on_base, hertz2d, hertz3d, oblique_impact, patch  # noqa: E402,F401
 
 __all__ = ["BASE", "UPPER", "FIXED", "LOADED", "SYMMETRY_X", "SYMMETRY_Y", "MASTER", "SLAVE",
            "NAMES", "to_dolfinx", "surface_nodes", "bar_impact", "block_on_base", "hertz2d", "hertz3d",
-           "patch"]
+           "oblique_impact", "patch"]

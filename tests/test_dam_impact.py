@@ -77,6 +77,18 @@ def test_dam_stays_in_equilibrium_before_contact(impact):
     assert r.problem.energy.balance_error_rel < 1e-6
 
 
+def test_every_dissipation_of_the_account_is_positive(impact):
+    """The log's front corner slides faster as the log turns: friction's work is taken
+    along the step's slip h U_t^θ, so that neither it nor the scheme's contact dissipation
+    (the normal impulses' work, ½ (1 − e) P_n |U_n⁻| at closing) comes out negative."""
+    _, r, _ = impact
+    e = r.problem.energy
+    tiny = 1e-12 * e.initial
+    assert e.contact >= -tiny and e.friction >= -tiny and e.numerical >= -tiny, e.row()
+    assert e.friction > 0.0
+    assert abs(e.balance_error_rel) < 1e-6
+
+
 def test_no_nan_in_the_fields(impact):
     _, r, _ = impact
     for f in r.problem.fields():

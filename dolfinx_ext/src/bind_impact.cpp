@@ -98,7 +98,11 @@ void flexcontact::bind_impact(py::module& m)
           "local frames), states, active, reaction (n_c, B^T P), normal_impulse, "
           "slave_impulse (d, global), pair_tangential, friction_work, contact_work, "
           "max_penetration, active_pairs, report")
-      .def("set_flexibility", &ImpactContact::set_flexibility, py::arg("F"), py::arg("dt_s"))
+      .def("set_flexibility", &ImpactContact::set_flexibility, py::arg("F"), py::arg("dt_s"),
+           "New F-hat (another time step): W_eff rebuilt, pairs kept")
+      .def("set_pairs", &ImpactContact::set_pairs, py::arg("pairs"), py::arg("mu"),
+           "New pairs on the same contact nodes: B, x0, W_eff rebuilt from the stored F-hat; "
+           "pair k keeps its last impulse and state as warm start")
       .def_property_readonly("B", [](const ImpactContact& c)
                              { return Eigen::SparseMatrix<double, Eigen::RowMajor>(c.B()); })
       .def_property_readonly("x0", [](const ImpactContact& c) { return c.x0(); })

@@ -46,6 +46,17 @@ void check_dt(double dt)
     throw std::invalid_argument(who + "dt_s is " + num(dt) + "; it must be finite and > 0");
 }
 
+void check_mu(const Vector& mu, std::size_t m)
+{
+  if (static_cast<std::size_t>(mu.size()) != m)
+    throw std::invalid_argument(who + "mu has " + std::to_string(mu.size())
+                                + " entries but there are " + std::to_string(m) + " pairs");
+  for (Eigen::Index k = 0; k < mu.size(); ++k)
+    if (!std::isfinite(mu[k]) || mu[k] < 0.0)
+      throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
+                                  + " is " + num(mu[k]) + "; it must be finite and >= 0");
+}
+
 void check_vector(const char* name, const Eigen::Ref<const Vector>& v, Eigen::Index n)
 {
   if (v.size() != n)
@@ -79,14 +90,7 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   if (!constrained_.empty() && static_cast<Eigen::Index>(constrained_.size()) != n_c)
     throw std::invalid_argument(who + "constrained has " + std::to_string(constrained_.size())
                                 + " entries, expected 0 or n_c = " + std::to_string(n_c));
-  if (static_cast<std::size_t>(mu_.size()) != pairs_.size())
-    throw std::invalid_argument(who + "mu has " + std::to_string(mu_.size())
-                                + " entries but there are " + std::to_string(pairs_.size())
-                                + " pairs");
-  for (Eigen::Index k = 0; k < mu_.size(); ++k)
-    if (!std::isfinite(mu_[k]) || mu_[k] < 0.0)
-      throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
-                                  + " is " + num(mu_[k]) + "; it must be finite and >= 0");
+  check_mu(mu_, pairs_.size());
   zero_constrained(F_, constrained_);
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
   x0_ = initial_gap(pairs_, X_);
@@ -103,6 +107,25 @@ void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
   W_ = delassus(B_, Fhat);
   F_ = std::move(Fhat);
   dt_ = dt_s;
+}
+
+void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
+{
+  check_mu(mu, pairs.size());
+  // Built aside first, so that bad pairs leave the object as it was.
+  auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
+  Vector x0 = initial_gap(pairs, X_);
+  Matrix W = delassus(B, F_);
+  if (pairs.size() != pairs_.size())
+  {
+    last_P_ = Vector::Zero(static_cast<Eigen::Index>(pairs.size()) * dim_);
+    last_states_.assign(pairs.size(), PairState::open);
+  }
+  B_ = std::move(B);
+  x0_ = std::move(x0);
+  W_ = std::move(W);
+  pairs_ = std::move(pairs);
+  mu_ = std::move(mu);
 }
 
 ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
@@ -168,7 +191,12 @@ void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
   for (std::size_t a = 0; a < act.size(); ++a)
   {
     // Newton's law U_n⁺ ≥ −e U_n⁻ becomes x_n = U_n⁺ + e U_n⁻ ≥ 0, a shift of q only.
-    q[a * d] += e_ * r.velocity_before[act[a] * d];
+    // It is a law for closing pairs. A pair of the index set that opens at the start of
+    // the step (U_n⁻ > 0, already overlapping) gets x_n = U_n⁺ + (1 − θ)/θ U_n⁻ = U_n^θ/θ
+    // instead: its gap may not shrink over the step, and its impulse does no work
+    // (P_n U_n^θ = 0) where Newton's law would let it do positive work (1 − θ − θe) P_n U_n⁻.
+    const double Un = r.velocity_before[act[a] * d];
+    q[a * d] += (Un <= 0.0 ? e_ : (1.0 - theta_) / theta_) * Un;
     mu[a] = mu_[act[a]];
     s0[a] = last_states_[act[a]] == PairState::open ? PairState::stick : last_states_[act[a]];
   }
@@ -195,6 +223,10 @@ void ImpactContact::finish(ImpactStep& r) const
   const int m = pairs(), d = dim_;
   r.slave_impulse = Vector::Zero(d);
   r.pair_tangential = Matrix::Zero(m, d);
+  // The works are taken at the θ-velocity: u⁺ − u⁻ = h v_θ, so U_θ h is the relative
+  // displacement of the step (the slip, for the tangential rows) and P·U_θ is exactly the
+  // contact term of the scheme's energy balance for every θ (docs/impact.md).
+  const Vector Utheta = theta_ * r.velocity + (1.0 - theta_) * r.velocity_before;
   double min_gap = 0.0;
   for (int k = 0; k < m; ++k)
   {
@@ -205,10 +237,10 @@ void ImpactContact::finish(ImpactStep& r) const
     for (int j = 1; j < d; ++j)
     {
       r.pair_tangential.row(k) += r.impulse[k * d + j] * T.row(j);
-      r.friction_work += r.impulse[k * d + j] * r.velocity[k * d + j];
+      r.friction_work += r.impulse[k * d + j] * Utheta[k * d + j];
     }
   }
-  r.contact_work = 0.5 * r.impulse.dot(r.velocity + r.velocity_before);
+  r.contact_work = r.impulse.dot(Utheta);
   r.max_penetration = std::max(0.0, -min_gap);
   r.reaction = B_.transpose() * r.impulse;
   for (std::size_t i = 0; i < constrained_.size(); ++i)

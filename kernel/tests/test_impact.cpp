@@ -114,7 +114,7 @@ TEST(Impact, MassSpringOnAWallLosesTheFrontMassEnergyAndBouncesOff)
   EXPECT_NEAR(r.impulse_x, m * (r.v[0] + r.v[2]) - m * (-2 * v), 1e-10 * m * v);
   EXPECT_NEAR((r.last_contact + 1 - r.first_contact) * h, tc, 0.01 * tc);
   EXPECT_NEAR(r.energy, 0.5 * m * v * v, 0.01 * 0.5 * m * v * v);
-  // Energy balance of the θ = ½ scheme: E − E0 = Σ P·(U⁺ + U⁻)/2, to round-off.
+  // Energy balance of the θ = ½ scheme: E − E0 = Σ P·U^θ, U^θ = (U⁺ + U⁻)/2, to round-off.
   EXPECT_NEAR(r.energy - r.energy0, r.contact_work, 1e-10 * r.energy0);
 }
 
@@ -144,6 +144,59 @@ TEST(Impact, FrictionImpulseIsMuTimesNormalWhileSliding)
   // Slow along the wall: it sticks, and the tangential velocity stops.
   const ImpactRun s = integrate(1e-3, 20, vec({-vn, 0.1}), e, mu, 0.0);
   EXPECT_NEAR(s.v[1], 0.0, 1e-9);
+}
+
+namespace
+{
+/// @brief One contact step of a slave node against a held wall node, W = I on the pair:
+/// contact DOFs (slave x, slave y, wall x, wall y), normal along x.
+ImpactStep one_step(const Vector& u_c, const Vector& v_c, const Vector& vfree_c, double e,
+                    double mu, double theta = 0.5)
+{
+  const Matrix X = Matrix::Zero(2, 2);
+  ImpactContact c(2, Matrix::Identity(4, 4), X, {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))},
+                  vec({mu}), e, 1e-3, theta, wall_held);
+  return c.step(u_c, v_c, vfree_c);
+}
+} // namespace
+
+TEST(Impact, FrictionWorkIsTakenAlongTheStepsSlip)
+{
+  // A node in contact slides at 0.1 and is pushed in (U_n,free = −1) and along (2) the
+  // wall: P_n = 1, P_t = μ against the slip, U_t⁺ = 2 − μ = 1.7. The slip of the step is
+  // h U_t^θ = h (U_t⁺ + U_t⁻)/2, so friction works −μ P_n (1.7 + 0.1)/2 and, with U_n⁺ = U_n⁻
+  // = 0, that is all the contact work: the scheme's own contact dissipation is zero. Taking
+  // friction's work at U_t⁺ instead (−μ P_n 1.7) left −0.24 as "contact dissipation".
+  const double mu = 0.3;
+  const ImpactStep s = one_step(vec({0, 0, 0, 0}), vec({0, 0.1, 0, 0}), vec({-1, 2, 0, 0}),
+                                0.0, mu);
+  ASSERT_EQ(s.active_pairs, 1);
+  EXPECT_NEAR(s.impulse[0], 1.0, 1e-10);
+  EXPECT_NEAR(std::abs(s.impulse[1]), mu, 1e-10);
+  EXPECT_NEAR(std::abs(s.velocity[1]), 2.0 - mu, 1e-10);
+  EXPECT_NEAR(s.friction_work, -mu * (2.0 - mu + 0.1) / 2, 1e-10);
+  EXPECT_NEAR(s.contact_work - s.friction_work, 0.0, 1e-10);
+  // θ = 1: the slip is h U_t⁺, and friction works −μ P_n |U_t⁺|.
+  const ImpactStep t = one_step(vec({0, 0, 0, 0}), vec({0, 0.1, 0, 0}), vec({-1, 2, 0, 0}),
+                                0.0, mu, 1.0);
+  EXPECT_NEAR(t.friction_work, -mu * (2.0 - mu), 1e-10);
+}
+
+TEST(Impact, AnOverlappingPairThatOpensDoesNoPositiveWork)
+{
+  // The node overlaps the wall by 1 cm and moves out at 0.05 (U_n⁻ > 0), but the free
+  // velocity pushes it in: Newton's law (closing pairs) does not apply; the gap is held
+  // over the step instead, U_n^θ = 0, so the impulse does no work (U_n⁺ = 0 would have let
+  // it work +½ P_n U_n⁻ > 0, an energy gain).
+  for (double theta : {0.5, 0.75, 1.0})
+  {
+    const ImpactStep s = one_step(vec({-0.01, 0, 0, 0}), vec({0.05, 0, 0, 0}),
+                                  vec({-1, 0, 0, 0}), 0.0, 0.0, theta);
+    ASSERT_EQ(s.active_pairs, 1);
+    EXPECT_GT(s.impulse[0], 0.0);
+    EXPECT_NEAR(theta * s.velocity[0] + (1 - theta) * s.velocity_before[0], 0.0, 1e-12);
+    EXPECT_NEAR(s.contact_work, 0.0, 1e-12) << "theta = " << theta;
+  }
 }
 
 TEST(Impact, BadInputIsNamed)

@@ -74,7 +74,8 @@ class ImpactProblem:
     materials : ``{cell_tag: forms.Material}``; every body needs E and a density > 0.
     bcs : Dirichlet conditions (zero values: fixed supports). A body whose nodes are all
         held is rigid: contact DOFs held by a condition get no flexibility.
-    contact : one ContactInterface or a list of them (node–node pairs).
+    contact : one ContactInterface or a list of them (node–node or node–surface pairs; no
+        rigid targets).
     dt_s : time step h [s], checked against the expected contact duration (at least
         ``setup.MIN_STEPS_IN_CONTACT`` steps), estimated as the shortest 2L/c of the
         bodies along the contact normal unless ``expected_contact_s`` is given.
@@ -89,6 +90,12 @@ class ImpactProblem:
     initial_displacement : a Function on V (m) to start from, e.g. a static state under
         ``loads`` (zeroed at held DOFs); None: zero. Its strain energy is the initial one.
     solver, flexibility : as for ContactProblem.
+
+    Node–surface pairs are re-made before every step but the first (``repair``: B, x0 and
+    W_eff from the stored F̂, no factorization; ``pairings`` counts them).
+    ``set_time_step`` changes h (one new factorization; ``factorizations`` counts them).
+    ``energy`` is the step-by-step energy account (energy.py), ``records`` one
+    ImpactStepRecord per step.
     """
 
     def __init__(self, V, cell_tags: MeshTags, bodies: dict[str, int], materials: dict,
@@ -126,6 +133,12 @@ class ImpactProblem:
         K_probe.destroy()
         self.bodies = setup.make_bodies(V, cell_tags, bodies, materials, self.marker)
         self.pairs, self.mu, self.m = pair_interfaces(V, self.interfaces, self.comm)
+        if any(i.rigid for i in self.interfaces):
+            raise ValueError("contact: a rigid target is not supported by ImpactProblem; "
+                             "mesh the obstacle and hold it with Dirichlet conditions")
+        # Node–surface pairs follow the bodies: re-made before every step (``repair``).
+        self.repairing = any(i.pairing != "node_to_node" for i in self.interfaces)
+        self.pairings = 1
         self._check_time_step(expected_contact_s)
         self.K, self.M = setup.assemble_matrices(self.a_form, self.m_form, self.bcs, mass,
                                                  self.marker)
@@ -172,9 +185,70 @@ class ImpactProblem:
                                          self.comm, self.options, flexibility, kernel=kernel)
         c = self.condensation
         self.factor, self.flex_info = c.factor, c.flex_info
-        self.contact, self.B, self.W_eff = c.contact, c.B, c.W
+        self.factorizations = 1
+        self.flexibility_method = flexibility
+        self._operators()
         self.timings.update(c.timings)
         self.timings["iteration_matrix_s"] = time.perf_counter() - t0
+
+    def _operators(self) -> None:
+        c = self.condensation
+        self.contact, self.B, self.W_eff = c.contact, c.B, c.W
+
+    def set_time_step(self, dt_s: float, expected_contact_s: Optional[float] = None) -> None:
+        """Continue with the time step ``dt_s`` [s]: Ŵ = M + hθC + h²θ²K of the new h is
+        factored once (``factorizations`` counts it) and W_eff rebuilt from it; pairs, state
+        and energy account are kept. The new step is checked against the expected contact
+        duration as in the constructor, before anything is changed. Collective."""
+        setup.check_scheme(dt_s, self.restitution, self.theta, self.mass_kind, self.rayleigh)
+        old = self.expected_contact_s
+        if expected_contact_s is not None:
+            if not (setup._finite(expected_contact_s) and expected_contact_s > 0):
+                raise ValueError(f"expected_contact_s={expected_contact_s!r}: must be a "
+                                 "finite number > 0 s")
+            old = float(expected_contact_s)
+        setup.check_resolution(float(dt_s), old, "the expected contact duration")
+        t0 = time.perf_counter()
+        W_hat = setup.iteration_matrix(self.K, self.M, float(dt_s), self.theta, self.rayleigh,
+                                       self.marker)
+        F, factor, info = _cpp.flexibility(W_hat, self.condensation.dofs,
+                                           self.flexibility_method)
+        error = None
+        if self.comm.rank == 0:
+            try:
+                self.contact.set_flexibility(np.asarray(F), float(dt_s))
+            except ValueError as e:
+                error = f"set_time_step: {e}"
+        error = self.comm.bcast(error, root=0)
+        if error:
+            raise ValueError(error)
+        self.W_hat.destroy()
+        self.W_hat, self.factor, self.flex_info = W_hat, factor, dict(info)
+        self.condensation.factor = factor
+        self.condensation.W = self.contact.W if self.comm.rank == 0 else None
+        self.dt, self.expected_contact_s = float(dt_s), old
+        self.factorizations += 1
+        self._operators()
+        self.timings.setdefault("refactor_s", []).append(time.perf_counter() - t0)
+
+    def repair(self) -> None:
+        """Re-make the node–surface pairs at the current positions x + u⁻: B, x0 and W_eff
+        from the stored F̂, no factorization; each pair keeps its last impulse and state as
+        the next step's warm start. Collective."""
+        c = self.condensation
+        uc = c.gather(self.u_vec)
+        error = None
+        if self.comm.rank == 0:
+            try:
+                self.pairs.repair(uc)
+                c.set_pairs(self.pairs, self.mu)
+            except ValueError as e:
+                error = f"time step {len(self.records) + 1}: re-pairing: {e}"
+        error = self.comm.bcast(error, root=0)
+        if error:
+            raise ValueError(error)
+        self._operators()
+        self.pairings += 1
 
     def _init_state(self, initial_velocity: Optional[dict], initial_displacement=None) -> None:
         self.u_vec = self.K.createVecLeft()
@@ -252,6 +326,8 @@ class ImpactProblem:
         """Advance one time step of size dt_s."""
         t0 = time.perf_counter()
         n_solves = self.back_substitutions
+        if self.repairing and self.records:
+            self.repair()
         vfree = self._free_velocity()
         out = self._contact(vfree)
         root = self.comm.rank == 0
@@ -299,12 +375,24 @@ class ImpactProblem:
         self.K.mult(u_new, Ku)
         strain = 0.5 * u_new.dot(Ku)
         u_new.destroy()
+        numerical = self._numerical_dissipation(du, v_new)  # before Mv holds M v⁺
         self.M.mult(v_new, Mv)
         kinetic = 0.5 * v_new.dot(Mv)
         works = (out["contact_work"], out["friction_work"]) if self.comm.rank == 0 else None
         cw, fw = self.comm.bcast(works, root=0)
-        self.energy.add_step(kinetic, strain, external, damping, cw, fw)
+        self.energy.add_step(kinetic, strain, external, damping, cw, fw, numerical)
         self._last_momentum = self._momentum(Mv)
+
+    def _numerical_dissipation(self, du: PETSc.Vec, v_new: PETSc.Vec) -> float:
+        """(θ − ½)(‖Δv‖²_M + ‖Δu‖²_K) of the step [J]: what the θ-method takes away."""
+        if self.theta == 0.5:
+            return 0.0
+        Mv, Ku, w = self._work
+        v_new.copy(w)
+        w.axpy(-1.0, self.v_vec)
+        self.M.mult(w, Mv)
+        self.K.mult(du, Ku)
+        return (self.theta - 0.5) * (w.dot(Mv) + du.dot(Ku))
 
     def _record(self, out: Optional[dict], solves: int) -> ImpactStepRecord:
         rec = None

@@ -1,16 +1,18 @@
 """The energy account of the Moreau–Jean θ-scheme, step by step (docs/impact.md).
 
-For θ = ½ the scheme satisfies exactly (multiply the discrete momentum balance by the
-mid-step velocity v_m = (v⁺ + v⁻)/2, with u⁺ − u⁻ = h v_m):
+Multiplying the discrete momentum balance by v_θ = θv⁺ + (1 − θ)v⁻ = (u⁺ − u⁻)/h gives,
+exactly and for every θ,
 
-    ΔE_kin + ΔE_strain = f·Δu − h v_mᵀ C v_m + Σ_k P_k·(U_k⁺ + U_k⁻)/2
+    ΔE_kin + ΔE_strain = f·Δu − h v_θᵀ C v_θ + Σ_k P_k·U_k^θ − (θ − ½)(‖Δv‖²_M + ‖Δu‖²_K)
 
-The last term is the work of the contact impulses. Its tangential part at U_t⁺,
-Σ P_t·U_t⁺ ≤ 0, is the friction dissipation; the rest is the scheme's own contact
-dissipation: ½ P_n (1 − e) U_n⁻ ≤ 0 for a pair that closes with restitution e (zero for
-e = 1), plus ½ P_t·(U_t⁻ − U_t⁺) of the tangential jump. Each term is computed here from its
-own definition, so the balance E_kin + E_strain + D_friction + D_damping + D_contact − W_ext
-= E_0 checks the implementation; for θ > ½ it also shows the scheme's numerical damping.
+with U^θ = θU⁺ + (1 − θ)U⁻ the pairs' relative velocity of the step (h U^θ is their relative
+displacement). The contact term splits into the work of the tangential impulses along the
+step's slip, Σ P_t·U_t^θ (minus the friction dissipation), and the work of the normal
+impulses, Σ P_n U_n^θ (minus the scheme's own contact dissipation): for a closing pair with
+restitution e, P_n U_n^θ = (1 − θ − θe) P_n U_n⁻, i.e. ½ (1 − e) P_n U_n⁻ ≤ 0 for θ = ½
+(zero for e = 1). The last term is the θ-method's numerical dissipation, zero for θ = ½.
+Each term is computed here from its own definition, so the balance E_kin + E_strain +
+D_friction + D_damping + D_contact + D_numerical − W_ext = E_0 checks the implementation.
 """
 from __future__ import annotations
 
@@ -24,9 +26,10 @@ class EnergyAccount:
     kinetic: float = 0.0
     strain: float = 0.0
     external_work: float = 0.0     # W_ext = Σ f·Δu
-    friction: float = 0.0          # D_friction = −Σ P_t·U_t⁺ ≥ 0
+    friction: float = 0.0          # D_friction = −Σ P_t·U_t^θ
     damping: float = 0.0           # D_damping = Σ h v_θᵀ C v_θ ≥ 0
-    contact: float = 0.0           # D_contact = −Σ P·(U⁺ + U⁻)/2 − D_friction (scheme)
+    contact: float = 0.0           # D_contact = −Σ P_n U_n^θ (the scheme's, at impacts)
+    numerical: float = 0.0         # D_numerical = Σ (θ − ½)(‖Δv‖²_M + ‖Δu‖²_K) ≥ 0
     initial: float = 0.0           # E_0 = E_kin + E_strain at t = 0
     history: list = field(default_factory=list, repr=False)
 
@@ -37,8 +40,8 @@ class EnergyAccount:
 
     @property
     def balance_error(self) -> float:
-        """E + D_friction + D_damping + D_contact − W_ext − E_0 [J]."""
-        return (self.total + self.friction + self.damping + self.contact
+        """E + D_friction + D_damping + D_contact + D_numerical − W_ext − E_0 [J]."""
+        return (self.total + self.friction + self.damping + self.contact + self.numerical
                 - self.external_work - self.initial)
 
     @property
@@ -53,18 +56,19 @@ class EnergyAccount:
         self.initial = kinetic + strain
 
     def add_step(self, kinetic: float, strain: float, external: float, damping: float,
-                 contact_work: float, friction_work: float) -> None:
+                 contact_work: float, friction_work: float, numerical: float = 0.0) -> None:
         """Book one step: the new energies and the step's works (signs as in the docstring)."""
         self.kinetic, self.strain = kinetic, strain
         self.external_work += external
         self.damping += damping
         self.friction -= friction_work
         self.contact -= contact_work - friction_work
+        self.numerical += numerical
         self.history.append(self.row())
 
     def row(self) -> dict:
         d = {k: getattr(self, k) for k in ("kinetic", "strain", "external_work", "friction",
-                                            "damping", "contact", "initial")}
+                                            "damping", "contact", "numerical", "initial")}
         d["total"] = self.total
         d["balance_error"] = self.balance_error
         return d

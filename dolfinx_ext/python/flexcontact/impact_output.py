@@ -10,7 +10,7 @@ from typing import Sequence, Union
 import numpy as np
 
 ENERGY_COLUMNS = ("kinetic", "strain", "external_work", "friction", "damping", "contact",
-                  "total", "balance_error")
+                  "numerical", "total", "balance_error")
 
 
 def contact_metrics(records: Sequence, dt_s: float, threshold: float = 1e-6) -> dict:
@@ -46,7 +46,7 @@ def write_history_csv(path: Union[str, os.PathLike], records: Sequence, energy0:
         w = csv.writer(fh)
         w.writerow(["t_s", "normal_force"] + [f"force_{c}" for c in "xyz"[:d]]
                    + list(ENERGY_COLUMNS) + ["active_pairs", "back_substitutions"])
-        w.writerow([0.0, 0.0] + [0.0] * d + [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, energy0, 0.0]
+        w.writerow([0.0, 0.0] + [0.0] * d + [0.0] * 7 + [energy0, 0.0]
                    + [0, 0])
         for r in records:
             w.writerow([repr(r.t_s), repr(r.normal_force)] + [repr(x) for x in r.slave_force]
@@ -73,7 +73,8 @@ def plot_history(path: Union[str, os.PathLike], records: Sequence, title: str,
     a1.legend()
     a1.grid(alpha=0.3)
     for key, style in (("kinetic", "-"), ("strain", "-"), ("contact", "--"),
-                       ("friction", "--"), ("damping", "--"), ("total", "k-")):
+                       ("friction", "--"), ("damping", "--"), ("numerical", ":"),
+                       ("total", "k-")):
         a2.plot(t, [r.energy[key] for r in records], style, label=key)
     a2.set_xlabel("t [ms]")
     a2.set_ylabel(f"energy [{energy_unit}]")

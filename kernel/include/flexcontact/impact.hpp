@@ -11,7 +11,8 @@
 /// velocity of the pairs in their local frames (normal first), the step's local problem is
 ///
 ///     U⁺ = W_eff P + U_free,   W_eff = B F̂ Bᵀ,
-///     for pairs of the index set I:  x_n = U_n⁺ + e U_n⁻ ≥ 0 ⟂ P_n ≥ 0,
+///     for pairs of the index set I:  x_n = U_n⁺ + e U_n⁻ ≥ 0 ⟂ P_n ≥ 0   (U_n⁻ ≤ 0),
+///                                    x_n = U_n⁺ + (1 − θ)/θ U_n⁻ ≥ 0 ⟂ P_n ≥ 0   (U_n⁻ > 0),
 ///                                    Coulomb on (P_t, U_t⁺) as in problem.hpp,
 ///     for the others:                P = 0,
 ///
@@ -42,9 +43,10 @@ struct ImpactStep
   double normal_impulse = 0.0;    ///< Σ_k P_n,k
   Vector slave_impulse;           ///< d, Σ_k T_kᵀ P_k: impulse on the slave side, global axes
   Matrix pair_tangential;         ///< m × d, T_kᵀ (0, P_t,k) per pair, global axes
-  /// Σ_k P_t,k·U_t,k⁺ ≤ 0: the work of friction (its dissipation is minus this)
+  /// Σ_k P_t,k·U_t,k^θ, U^θ = θU⁺ + (1 − θ)U⁻: the work of the tangential impulses along
+  /// the step's slip h U_t^θ (the friction dissipation is minus this)
   double friction_work = 0.0;
-  /// Σ_k P_k·(U_k⁺ + U_k⁻)/2: the work of all contact impulses in the θ = ½ energy balance
+  /// Σ_k P_k·U_k^θ: the work of all contact impulses in the scheme's energy balance
   double contact_work = 0.0;
   double max_penetration = 0.0;   ///< max(0, −min_k g_n,k) at the start of the step
   int active_pairs = 0;           ///< |I|
@@ -79,6 +81,12 @@ public:
   /// @throws ConvergenceError if no local solver converges (the warm start is kept)
   ImpactStep step(const Eigen::Ref<const Vector>& u_c, const Eigen::Ref<const Vector>& v_c,
                   const Eigen::Ref<const Vector>& vfree_c);
+
+  /// @brief New pairs on the same contact nodes (re-pairing between steps): B, x0 and
+  /// W_eff rebuilt from the stored F̂, no factorization. Pair k keeps its last impulse and
+  /// state as the next step's warm start (pair k is slave node k's before and after).
+  /// @throws std::invalid_argument on bad pairs or mu; the object is then unchanged
+  void set_pairs(std::vector<ContactPair> pairs, Vector mu);
 
   /// @brief New time-step size: F̂ of the new Ŵ, W_eff rebuilt; pairs kept.
   /// @throws std::invalid_argument on a wrong size, non-finite entries or dt_s ≤ 0

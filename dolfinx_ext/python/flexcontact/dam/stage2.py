@@ -13,8 +13,8 @@ Starts from stage 1 (:mod:`flexcontact.dam.stage1`) on the same mesh and functio
   its stiffness unchanged;
 * contact: the log's front end (slave; with the pitched log its lower front corner hits
   first) against the dam's upstream face (master), node–surface with the scenario's μ.
-  The pairs are made once from the initial positions and kept for the whole run: over the
-  few milliseconds of contact the log slides along the face by far less than an element.
+  ImpactProblem re-makes the pairs before every step at the current positions (over the
+  few milliseconds of contact the log slides along the face by far less than an element).
 
 Not modelled: the reservoir's added mass on the dam (Westergaard; ``westergaard=True`` is
 rejected here), water damping, the wood's across-grain softness and crushing.
