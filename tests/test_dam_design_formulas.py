@@ -69,3 +69,31 @@ def test_matsutomi_by_hand():
 def test_bad_input_names_the_parameter(call):
     with pytest.raises(ValueError, match="must be a finite number > 0"):
         call()
+
+
+def test_comparison_demo_in_2d(tmp_path):
+    """The comparison script on one 2D run: its formula columns are the module's, and the
+    computed peak per metre stays below the elastic wave bound of the plane-strain slab
+    (thickness D, modulus E/(1−ν²), density with the added mass) hitting a rigid wall."""
+    import csv
+
+    from demo_runner import run_demo
+    from flexcontact.dam import DamScenario
+    summary, folder = run_demo("dam_design_formulas", "--dim", "2", "--speeds", "2",
+                               "--lengths", "10", "--no-plot", results=tmp_path)
+    with open(folder / "comparison.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 1 and (folder / "comparison.md").is_file()
+    row = {k: float(v) for k, v in rows[0].items() if k not in ("contact_ended",)}
+    s = DamScenario(log_speed_m_s=2.0)
+    w = s.wood
+    expected = dfm.all_formulas_N(s.log_mass_kg(), 2.0, s.log_diameter_m, 10.0, w.E_Pa,
+                                  w.rho_kg_m3, s.wood_crushing_strength_Pa)
+    for key, value in expected.items():
+        assert row[key] == pytest.approx(value, rel=1e-12), key
+    D = s.log_diameter_m
+    slab_bound = D * math.sqrt(w.E_Pa / (1 - w.nu ** 2) * w.rho_kg_m3
+                               * (1 + s.added_mass_coefficient)) * 2.0
+    per_metre = row["computed_N"] / D
+    assert 0 < per_metre <= slab_bound, (per_metre, slab_bound)
+    assert rows[0]["contact_ended"] == "True"

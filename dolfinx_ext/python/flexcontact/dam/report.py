@@ -62,13 +62,21 @@ def _limits(st2: dict | None) -> list:
     return out
 
 
-def _stage1(st1: dict, unit: str) -> list:
+def _units(dim: int) -> dict:
+    """Unit strings of forces, moments and impulses (per metre of dam in 2D)."""
+    if dim == 2:
+        return {"force": "N/m", "moment": "N·m/m", "impulse": "N·s/m", "mforce": "MN/m"}
+    return {"force": "N", "moment": "N·m", "impulse": "N·s", "mforce": "MN"}
+
+
+def _stage1(st1: dict, u: dict) -> list:
     sec = st1["base_section"]
     rows = ["## Stage 1: statics against hand statics", "",
             "| quantity | finite elements | hand statics | relative error |",
             "|---|---|---|---|"]
-    for key, label in (("normal_force_N", f"N [{unit}]"), ("shear_force_N", f"shear [{unit}]"),
-                       ("moment_heel_Nm", f"M about the heel [{unit}·m]"),
+    for key, label in (("normal_force_N", f"N [{u['force']}]"),
+                       ("shear_force_N", f"shear [{u['force']}]"),
+                       ("moment_heel_Nm", f"M about the heel [{u['moment']}]"),
                        ("sigma_heel_Pa", "σ heel [Pa]"), ("sigma_toe_Pa", "σ toe [Pa]")):
         rows.append(f"| {label} | {sec[key]:.6e} | {sec[key + '_ref']:.6e} | "
                     f"{sec[key + '_error_rel']:.1e} |")
@@ -79,13 +87,13 @@ def _stage1(st1: dict, unit: str) -> list:
     return rows
 
 
-def _stage2(st2: dict, unit: str) -> list:
+def _stage2(st2: dict, u: dict) -> list:
     return [
         "## Stage 2: the impact", "",
-        f"* Peak contact force {st2['peak_force'] / 1e6:.4g} M{unit} at t = "
+        f"* Peak contact force {st2['peak_force'] / 1e6:.4g} {u['mforce']} at t = "
         f"{st2['peak_force_t_s'] * 1e3:.3f} ms; contact {st2['contact_duration_s'] * 1e3:.3f} ms "
         f"(2L/c of the log {st2['contact_duration_s_ref_log_2L_c'] * 1e3:.3f} ms); impulse "
-        f"{st2['impulse']:.6e} {unit}·s (the log's m Δv {st2['impulse_ref']:.6e}).",
+        f"{st2['impulse']:.6e} {u['impulse']} (the log's m Δv {st2['impulse_ref']:.6e}).",
         f"* Linearised heel stress: {_mpa(st2['sigma_heel_before_Pa'])} MPa before the impact "
         f"(hand statics {_mpa(st2['sigma_heel_before_Pa_ref'])} MPa), at most "
         f"{_mpa(st2['sigma_heel_during_max_Pa'])} MPa during the run (t = "
@@ -111,8 +119,9 @@ def _mesh_study(rows: list) -> list:
             "The last row is the relative change from the coarser to the finer mesh: a "
             "quantity that moves by more than a few percent is not converged at these sizes. "
             "The linearised heel and toe stresses come from the base section's force and "
-            "moment (global quantities; their change reflects the dam's dynamic response, "
-            "not a singularity); the contact pressure under the log's corner is singular "
+            "moment (global quantities): their change is not a singularity but the far-field "
+            "mesh (3 m, then 1.5 m by default) carrying the waves that cross the dam; a third "
+            "mesh would tell how far they are from converged. The contact pressure under the log's corner is singular "
             "and grows with refinement, so it is no design value.", ""]
     return out
 
@@ -122,7 +131,7 @@ def write_report(folder, summary: dict, mesh_study: list | None = None,
     """Write ``folder/report.md`` from the demo's summary (rank 0 only)."""
     folder = Path(folder)
     s, st1, st2 = summary["scenario"], summary["stage1"], summary.get("stage2")
-    unit = "N/m" if s["dim"] == 2 else "N"
+    unit = _units(s["dim"])
     lines = ["# Floating log against a concrete gravity dam", "",
              "Written by `demos/dam_debris.py`; numbers from `summary.json` (SI, tension "
              "positive" + (", per metre of dam" if s["dim"] == 2 else "") + ").", ""]
