@@ -182,7 +182,7 @@ if comm.rank == 0:
 
 # %%
 if not args.stage1_only:
-    from flexcontact.dam.numbers import engineer_numbers, mesh_study_row
+    from flexcontact.dam.key_numbers import engineer_numbers, mesh_study_row
     from flexcontact.dam.plot import plot_stress_histories
     from flexcontact.dam.stage2 import approach_time_s, response_duration_s, solve_stage2
     from flexcontact.impact_output import plot_history, write_history_csv

@@ -14,7 +14,7 @@ from flexcontact import compat
 from flexcontact.dam import DamScenario
 from flexcontact.dam.kinematics import (ROTATION_LIMIT_RAD, STRAIN_LIMIT, LogKinematics,
                                         SmallStrainWarning)
-from flexcontact.dam.numbers import engineer_numbers
+from flexcontact.dam.key_numbers import engineer_numbers
 from flexcontact.dam.stage1 import solve_stage1
 from flexcontact.dam.stage2 import response_duration_s, solve_stage2
 
@@ -145,3 +145,14 @@ def test_a_fast_log_leaves_the_small_strain_range_with_a_warning():
     with pytest.warns(SmallStrainWarning, match=r"log: largest principal strain"):
         r = solve_stage2(s, stage1, duration_s=0.003, comm=COMM)
     assert r.log_max_strain > STRAIN_LIMIT
+
+
+def test_a_missing_pvbatch_is_reported_not_raised(tmp_path, monkeypatch):
+    import shutil
+
+    from flexcontact.dam import picture
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    done, message = picture.render_stress_picture(tmp_path / "none.xdmf", tmp_path / "x.png",
+                                                  1.0)
+    assert not done and "pvbatch not found" in message
+    assert not (tmp_path / "x.png").exists()

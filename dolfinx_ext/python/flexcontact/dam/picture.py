@@ -26,8 +26,9 @@ def render_stress_picture(xdmf_path, png_path, scale: float,
     if xvfb is not None:
         # xvfb-run's default screen (8-bit, no GLX) cannot host an OpenGL window.
         cmd = [xvfb, "-a", "-s", "-screen 0 1280x1024x24 +extension GLX", *cmd]
-    # Two tries: a virtual X server started while others start theirs can fail to connect.
-    for _ in range(2):
+    # Three tries: a virtual X server started while others start theirs can fail to
+    # connect (seen here about one start in three on a busy machine).
+    for _ in range(3):
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s)
         except (OSError, subprocess.TimeoutExpired) as err:

@@ -51,6 +51,12 @@ bar.Title = f"{field} (displacement ×{scale:.3g})"
 bar.ComponentTitle = ""
 bar.TitleColor = [0.0, 0.0, 0.0]
 bar.LabelColor = [0.0, 0.0, 0.0]
+b = warp.GetDataInformation().GetBounds()
+if b[5] > b[4]:  # 3D: look at the upstream face (x = 0) from upstream, above and aside
+    centre = [0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])]
+    view.CameraFocalPoint = centre
+    view.CameraPosition = [centre[0] - 1.0, centre[1] - 0.7, centre[2] + 0.5]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
 view.ResetCamera()
 Render(view)
 SaveScreenshot(out, view)

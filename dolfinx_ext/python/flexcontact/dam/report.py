@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .numbers import MESH_STUDY_COLUMNS
+from .key_numbers import MESH_STUDY_COLUMNS
 
 
 def _mpa(x) -> str:
