@@ -184,6 +184,7 @@ if comm.rank == 0:
 if not args.stage1_only:
     from flexcontact.dam.key_numbers import engineer_numbers, mesh_study_row
     from flexcontact.dam.plot import plot_stress_histories
+    from flexcontact.dam.section import write_section_csv
     from flexcontact.dam.stage2 import approach_time_s, response_duration_s, solve_stage2
     from flexcontact.impact_output import plot_history, write_history_csv
     duration = args.duration or response_duration_s(s)
@@ -198,6 +199,7 @@ if not args.stage1_only:
                                            stage1.kind)], stage2.peak_time_s)
     if comm.rank == 0:
         write_history_csv(folder / "impact_force.csv", records, p2.energy.initial)
+        write_section_csv(folder / "base_section.csv", stage2.section_history)
         if not args.no_plot:
             unit = "N/m" if s.dim == 2 else "N"
             plot_history(folder / "impact_force.png", records, "log on the dam's face",
@@ -241,7 +243,7 @@ if not args.stage1_only:
 # installed; otherwise the report says so.
 
 # %%
-paraview = None
+paraview = (False, "skipped (--no-paraview)") if args.no_paraview else None
 if not args.stage1_only and not args.no_paraview:
     from flexcontact.dam.picture import render_stress_picture, warp_scale
     paraview = (False, "not rendered")

@@ -153,7 +153,9 @@ def write_report(folder, summary: dict, mesh_study: list | None = None,
         lines += ["![largest principal stress at the peak force, ParaView](stress_paraview.png)"
                   if done else f"No ParaView picture: {message}.", ""]
     lines += ["Time series for ParaView: `stage1.xdmf`, `impact.xdmf` (every 5th step), "
-              "`impact_peak.xdmf` (the step of the peak force).", ""]
+              "`impact_peak.xdmf` (the step of the peak force); per step: `impact_force.csv` "
+              "(contact force, energies), `base_section.csv` (base force, moment, "
+              "linearised heel and toe stresses).", ""]
     path = folder / "report.md"
     path.write_text("\n".join(lines))
     return path

@@ -171,3 +171,17 @@ def peak_at_offset(f, point, offset_m: float, cell_tags=None, tag=None, samples:
     everyone = msh.comm.allgather((best, where))
     best, where = max(everyone, key=lambda bw: bw[0])
     return (best, where) if np.isfinite(best) else (float("nan"), None)
+
+
+def write_section_csv(path, history) -> None:
+    """One row per time of ``history`` [(t_s, BaseSection)]: the section's force, moment and
+    linearised heel and toe stresses (call on one rank)."""
+    import csv
+    keys = ("normal_force_N", "shear_force_N", "moment_heel_Nm", "sigma_heel_Pa",
+            "sigma_toe_Pa")
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(("t_s",) + keys)
+        for t, sec in history:
+            d = sec.as_dict()
+            w.writerow([repr(float(t))] + [repr(float(d[k])) for k in keys])
