@@ -156,3 +156,13 @@ def test_a_missing_pvbatch_is_reported_not_raised(tmp_path, monkeypatch):
                                                   1.0)
     assert not done and "pvbatch not found" in message
     assert not (tmp_path / "x.png").exists()
+
+
+def test_dam_period_estimate_by_hand():
+    from flexcontact.dam.stage2 import dam_period_estimate_s
+    # T₁ = 1.4 H/√E with H = 30 m = 98.425 ft and E = 25 GPa = 3.6259e6 psi: 0.07236 s.
+    h_ft, e_psi = 30.0 / 0.3048, 25e9 / 6894.757
+    assert h_ft == pytest.approx(98.425, rel=1e-5) and e_psi == pytest.approx(3.6259e6, rel=1e-4)
+    assert dam_period_estimate_s(DamScenario()) == pytest.approx(1.4 * h_ft / math.sqrt(e_psi),
+                                                                 rel=1e-14)
+    assert dam_period_estimate_s(DamScenario()) == pytest.approx(0.07236, rel=1e-3)

@@ -47,8 +47,10 @@ def warp_scale(u, cell_tags, tag: int, length_m: float, fraction: float = 0.05) 
     millimetres). Collective."""
     import dolfinx.fem
     from mpi4py import MPI
+    from .. import compat
     V = u.function_space
     tdim = V.mesh.topology.dim
+    compat.create_connectivity(V.mesh, tdim, tdim)  # DOLFINx 0.9 needs it for cell entities
     cells = cell_tags.indices[cell_tags.values == tag]
     blocks = dolfinx.fem.locate_dofs_topological(V, tdim, cells)
     bs = V.dofmap.index_map_bs

@@ -143,6 +143,12 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     distance from the first-contact point on the face at which the largest principal
     stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
     ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps.
+
+    Besides the contact metrics the result holds, for every step, the base section from
+    the dam's displacement (``section_history``), the log's largest rigid rotation and
+    strain (a :class:`~flexcontact.dam.kinematics.SmallStrainWarning` when they leave the
+    small range) and the displacement at the step of the peak force (``peak_state``). The
+    default duration ends before the base responds; :func:`response_duration_s` covers it.
     """
     s = scenario
     if s.westergaard:
