@@ -12,8 +12,8 @@ G_FT_S2 = 9.80665 / FT_M  # standard gravity in ft/s² (32.174)
 
 
 def test_asce7_in_us_units_as_the_commentary_writes_it():
-    # The commentary's example debris: W = 1000 lb at 10 ft/s, Δt = 0.03 s, C_O = 0.8,
-    # every other coefficient 1: F = π·1000·10·0.8 / (2·32.174·0.03) lb.
+    # The commentary's recommended debris weight W = 1000 lb, here at 10 ft/s, Δt = 0.03 s,
+    # C_O = 0.8, every other coefficient 1: F = π·1000·10·0.8 / (2·32.174·0.03) lb.
     f_lb = math.pi * 1000.0 * 10.0 * 0.8 / (2.0 * G_FT_S2 * 0.03)
     assert abs(f_lb - 13019.0) < 1.0  # by hand: 25132.7 / 1.93044
     f = dfm.asce7_force_N(1000.0 * LB_N, 10.0 * FT_M)
