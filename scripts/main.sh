@@ -6,4 +6,4 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 bash "$here/scripts/setup.sh"
 cd "$here"
 /usr/bin/python3 demos/dam_debris.py "$@"
-echo "Outputs: $here/results/dam_debris/ (XDMF for ParaView, PNG pictures, summary.json)"
+echo "Outputs: $here/results/dam_debris/ (report.md, XDMF for ParaView, PNG pictures, summary.json)"

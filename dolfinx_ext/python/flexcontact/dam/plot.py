@@ -67,3 +67,45 @@ def plot_groups(mesh, path, scenario=None) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+def plot_stress_histories(path, stage2, scenario) -> None:
+    """PNG (rank 0) of the impact's stresses against time: the contact force, the peak
+    largest principal stress at the stated offset from the impact, and the linearised
+    heel and toe stresses of the base section, the contact window shaded."""
+    if stage2.problem.comm.rank != 0:
+        return
+    from ..output import pyplot
+    plt = pyplot()
+    unit = "MN/m" if scenario.dim == 2 else "MN"
+    rec = stage2.problem.records
+    t_ms = np.array([r.t_s for r in rec]) * 1e3
+    force = np.array([r.normal_force for r in rec]) * 1e-6
+    met = stage2.metrics
+    fig, axes = plt.subplots(3, 1, figsize=(8, 9), sharex=True)
+    axes[0].plot(t_ms, force, color="tab:red")
+    axes[0].set_ylabel(f"contact force [{unit}]")
+    if stage2.stress_history:
+        ts, sp = np.array(stage2.stress_history).T
+        axes[1].plot(ts * 1e3, sp * 1e-6, ".-", color="tab:purple",
+                     label=f"peak σ₁ at {stage2.offset_m:g} m from the impact")
+    axes[1].axhline(scenario.concrete_tensile_strength_Pa * 1e-6, color="k", ls="--", lw=0.8,
+                    label="concrete tensile strength")
+    axes[1].set_ylabel("stress [MPa]")
+    axes[1].legend(fontsize=8)
+    th = np.array([h[0] for h in stage2.section_history]) * 1e3
+    axes[2].plot(th, [h[1].sigma_heel_Pa * 1e-6 for h in stage2.section_history],
+                 label="heel (linearised)")
+    axes[2].plot(th, [h[1].sigma_toe_Pa * 1e-6 for h in stage2.section_history],
+                 label="toe (linearised)")
+    axes[2].axhline(0.0, color="k", lw=0.5)
+    axes[2].set_ylabel("base normal stress [MPa]\n(tension > 0)")
+    axes[2].set_xlabel("t [ms]")
+    axes[2].legend(fontsize=8)
+    if met.get("contact_start_s") is not None and np.isfinite(met["contact_start_s"]):
+        for ax in axes:
+            ax.axvspan(met["contact_start_s"] * 1e3, met["contact_end_s"] * 1e3,
+                       color="tab:orange", alpha=0.15, lw=0)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

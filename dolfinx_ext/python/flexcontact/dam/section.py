@@ -188,3 +188,17 @@ def offset_sample_cells(msh, point, offset_m: float, cell_tags=None, tag=None,
     constant field its peak at the offset is the largest value over these cells."""
     _, _, cells = offset_samples(msh, point, offset_m, cell_tags, tag, samples)
     return np.unique(cells).astype(np.int32)
+
+
+def write_section_csv(path, history) -> None:
+    """One row per time of ``history`` [(t_s, BaseSection)]: the section's force, moment and
+    linearised heel and toe stresses (call on one rank)."""
+    import csv
+    keys = ("normal_force_N", "shear_force_N", "moment_heel_Nm", "sigma_heel_Pa",
+            "sigma_toe_Pa")
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(("t_s",) + keys)
+        for t, sec in history:
+            d = sec.as_dict()
+            w.writerow([repr(float(t))] + [repr(float(d[k])) for k in keys])

@@ -168,22 +168,32 @@ def _sections(s, V, uh, loads, dx, kind, mesh):
     """Base section from the dam's residual and (sign reversed) from the foundation's, each
     with the uplift resultant added (it does not enter the FE loads, see above)."""
     v = ufl.TestFunction(V)
-    w = 1.0 if s.dim == 2 else s.dam_width_m
-    B = s.base_width_m
-    r_dam = loads["dam"] - elasticity_form(uh, v, s.concrete, dx(T.DAM), kind)
     r_found = elasticity_form(uh, v, s.rock, dx(T.FOUNDATION), kind) - loads["foundation"]
-    out = []
-    for r in (r_dam, r_found):
-        sec = nodal_section(V, dolfinx.fem.form(r), mesh.facet_tags, T.DAM_BASE, B, w)
-        if s.uplift_factor > 0:
-            force, at = uplift_resultant(s)
-            up = np.zeros(s.dim)
-            up[-1] = force * w
-            point = np.zeros(s.dim)
-            point[0] = at
-            sec = sec.plus(up, point)
-        out.append(sec)
-    return out
+    return [dam_section(s, V, section_form(s, V, uh, loads, dx, kind), mesh),
+            dam_section(s, V, dolfinx.fem.form(r_found), mesh)]
+
+
+def section_form(s, V, u, loads, dx, kind):
+    """The compiled residual L_dam(v) − a_dam(u, v) of the dam's cells: at the base nodes,
+    the forces the dam hands to the foundation for the displacement ``u`` (a Function on
+    V, read when the form is assembled, so one compiled form serves every time step)."""
+    v = ufl.TestFunction(V)
+    return dolfinx.fem.form(loads["dam"] - elasticity_form(u, v, s.concrete, dx(T.DAM), kind))
+
+
+def dam_section(s, V, residual_form, mesh: DamMesh) -> BaseSection:
+    """The base section from a compiled residual (:func:`section_form`), the uplift
+    resultant added. Collective."""
+    w = 1.0 if s.dim == 2 else s.dam_width_m
+    sec = nodal_section(V, residual_form, mesh.facet_tags, T.DAM_BASE, s.base_width_m, w)
+    if s.uplift_factor > 0:
+        force, at = uplift_resultant(s)
+        up = np.zeros(s.dim)
+        up[-1] = force * w
+        point = np.zeros(s.dim)
+        point[0] = at
+        sec = sec.plus(up, point)
+    return sec
 
 
 def upstream_water_resultant(result: Stage1Result) -> tuple[float, float]:

@@ -39,9 +39,10 @@ from ..forms import Material
 from ..impact_output import contact_metrics
 from ..meshes import dam_tags as T
 from ..problem import ContactInterface
-from .fields import stress_fields
+from .fields import StressFields
+from .kinematics import LogKinematics
 from .section import peak_at_offset
-from .stage1 import _measures, body_loads
+from .stage1 import _measures, body_loads, dam_section, section_form
 
 MARGIN = 1.5
 """The run lasts approach + MARGIN × the expected contact duration (2L/c of the log)."""
@@ -64,6 +65,25 @@ class Stage2Result:
     offset_m: float
     peak_contact_pressure_Pa: float  # largest mean pressure of a step (impulse/h/area)
     timings_s: dict = field(default_factory=dict)
+    section_history: list = field(default_factory=list)  # (t_s, BaseSection) every step
+    peak_state: Any = None        # displacement Function at the step of the peak force
+    peak_time_s: float = float("nan")
+    log_max_rotation_rad: float = 0.0
+    log_max_strain: float = 0.0
+
+    def section_extremes(self) -> dict:
+        """Extremes over the run of the linearised base stresses (Pa, tension positive)
+        and of the base-section moment about the heel, with their times."""
+        if not self.section_history:
+            return {}
+        t = np.array([h[0] for h in self.section_history])
+        heel = np.array([h[1].sigma_heel_Pa for h in self.section_history])
+        toe = np.array([h[1].sigma_toe_Pa for h in self.section_history])
+        m = np.array([h[1].moment_heel_Nm for h in self.section_history])
+        i, j, k = int(np.argmax(heel)), int(np.argmin(toe)), int(np.argmax(m))
+        return {"sigma_heel_max_Pa": float(heel[i]), "sigma_heel_max_t_s": float(t[i]),
+                "sigma_toe_min_Pa": float(toe[j]), "sigma_toe_min_t_s": float(t[j]),
+                "moment_heel_max_Nm": float(m[k]), "moment_heel_max_t_s": float(t[k])}
 
     @property
     def peak_tensile_stress_Pa(self) -> float:
@@ -123,6 +143,12 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     distance from the first-contact point on the face at which the largest principal
     stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
     ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps.
+
+    Besides the contact metrics the result holds, for every step, the base section from
+    the dam's displacement (``section_history``), the log's largest rigid rotation and
+    strain (a :class:`~flexcontact.dam.kinematics.SmallStrainWarning` when they leave the
+    small range) and the displacement at the step of the peak force (``peak_state``). The
+    default duration ends before the base responds; :func:`response_duration_s` covers it.
     """
     s = scenario
     if s.westergaard:
@@ -143,15 +169,17 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     cells = stage1.mesh.cell_tags
     materials = {T.DAM: s.concrete, T.FOUNDATION: s.rock, T.LOG: s.wood}
     history, p_peak = [], 0.0
+    watch = _Watch(s, stage1, problem)
 
-    def stresses():
-        return stress_fields(stage1.V, problem.u, cells, materials, stage1.kind)
+    fields = StressFields(stage1.V, problem.u, cells, materials, stage1.kind)
+    stresses = fields.update
 
     n = int(round(duration_s / dt))
     if writer is not None:
         writer.write(problem.fields() + stresses(), 0.0)
     for i in range(n):
         rec = problem.step()
+        watch.after_step(rec)
         if writer is not None and (i + 1) % write_every == 0:
             writer.write(problem.fields() + stresses(), problem.t)
         if rec.active > 0 and (i % stress_every == 0):
@@ -163,7 +191,51 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     m_eff, v0, v1 = _log_momentum(problem)
     return Stage2Result(problem, metrics, m_eff * (v1 - v0), m_eff, v0, v1, history, impact,
                         offset_m, p_peak, {"setup": t_setup, "steps": time.perf_counter() - t0 - t_setup,
-                                   "dt_s": dt, "duration_s": duration_s, "steps_n": n})
+                                   "dt_s": dt, "duration_s": duration_s, "steps_n": n},
+                        watch.sections, watch.peak_u, watch.peak_t,
+                        watch.log.max_rotation_rad, watch.log.max_strain)
+
+
+class _Watch:
+    """What stage 2 follows at every step besides the contact records: the base section
+    from the dam's displacement, the log's rotation and strain (warning when they leave
+    the small range, see kinematics.py) and the displacement at the peak contact force."""
+
+    def __init__(self, s, stage1, problem):
+        dx, ds = _measures(stage1.mesh)
+        v = ufl.TestFunction(stage1.V)
+        self.s, self.V, self.mesh, self.problem = s, stage1.V, stage1.mesh, problem
+        self.form = section_form(s, stage1.V, problem.u, body_loads(s, v, dx, ds),
+                                 dx, stage1.kind)
+        self.sections = [(0.0, dam_section(s, stage1.V, self.form, stage1.mesh))]
+        self.log = LogKinematics(problem.u, stage1.mesh.cell_tags, T.LOG)
+        self.peak_u = dolfinx.fem.Function(stage1.V, name="displacement_m")
+        self.peak_u.x.array[:] = problem.u.x.array
+        self.peak_force, self.peak_t = -1.0, float("nan")
+
+    def after_step(self, rec) -> None:
+        t = self.problem.t
+        self.sections.append((t, dam_section(self.s, self.V, self.form, self.mesh)))
+        self.log.measure(t)
+        if rec.normal_force > self.peak_force:
+            self.peak_force, self.peak_t = rec.normal_force, t
+            self.peak_u.x.array[:] = self.problem.u.x.array
+
+
+def dam_period_estimate_s(s) -> float:
+    """Fundamental period of the dam on rigid ground, T₁ = 1.4 H/√E in feet and psi
+    (Fenves & Chopra's simplified analysis of concrete gravity dams), i.e.
+    T₁ ≈ 381 H/√E with H in m and E in Pa. Only used to choose how long to simulate."""
+    feet_per_m, pa_per_psi = 1.0 / 0.3048, 6894.757
+    return 1.4 * s.dam_height_m * feet_per_m / math.sqrt(s.concrete.E_Pa / pa_per_psi)
+
+
+def response_duration_s(s) -> float:
+    """A run long enough to see the dam's base respond: the approach, the contact (2L/c of
+    the log) and half the dam's first period after it, when the base moment from the
+    impulse peaks (the stress wave needs H/c ≈ 10 ms just to reach the base)."""
+    contact = default_time_step_s(s, steps_in_contact=1)
+    return approach_time_s(s) + contact + 0.5 * dam_period_estimate_s(s)
 
 
 def approach_time_s(s) -> float:

@@ -1,0 +1,80 @@
+"""The numbers a dam engineer reads off one run of the scenario (stage 1 and stage 2).
+
+Forces per metre of dam in 2D (N/m), for the whole block in 3D (N); stresses in Pa,
+tension positive. Each ``q`` that theory fixes comes with ``q_ref``.
+"""
+from __future__ import annotations
+
+from .kinematics import ROTATION_LIMIT_RAD, STRAIN_LIMIT
+
+
+def engineer_numbers(s, stage1, stage2) -> dict:
+    """Base-section (linearised) heel and toe stresses before and during the impact, the
+    peak largest principal stress at the stated offset from the impact, the contact force,
+    duration and impulse, the ratios to the strengths and the log's kinematics."""
+    before = stage1.section
+    ext = stage2.section_extremes()
+    ft, fc = s.concrete_tensile_strength_Pa, s.wood_crushing_strength_Pa
+    met = stage2.metrics
+    sigma_peak = stage2.peak_tensile_stress_Pa
+    return {
+        "sigma_heel_before_Pa": before.sigma_heel_Pa,
+        "sigma_heel_before_Pa_ref": stage1.reference.sigma_heel_Pa,
+        "sigma_toe_before_Pa": before.sigma_toe_Pa,
+        "sigma_toe_before_Pa_ref": stage1.reference.sigma_toe_Pa,
+        "sigma_heel_during_max_Pa": ext["sigma_heel_max_Pa"],
+        "sigma_heel_during_max_t_s": ext["sigma_heel_max_t_s"],
+        "sigma_toe_during_min_Pa": ext["sigma_toe_min_Pa"],
+        "sigma_toe_during_min_t_s": ext["sigma_toe_min_t_s"],
+        "moment_heel_during_max_Nm": ext["moment_heel_max_Nm"],
+        "sigma_heel_before_over_tensile_strength": before.sigma_heel_Pa / ft,
+        "sigma_heel_during_over_tensile_strength": ext["sigma_heel_max_Pa"] / ft,
+        "peak_force": met["peak_force"],
+        "peak_force_t_s": stage2.peak_time_s,
+        "contact_duration_s": met["contact_duration_s"],
+        "contact_duration_s_ref_log_2L_c": stage2.problem.expected_contact_s,
+        "impulse": met["impulse"],
+        "impulse_ref": -stage2.log_momentum_change,
+        "peak_max_principal_stress_near_impact_Pa": sigma_peak,
+        "impact_offset_m": stage2.offset_m,
+        "peak_stress_over_tensile_strength": sigma_peak / ft,
+        "peak_contact_pressure_Pa": stage2.peak_contact_pressure_Pa,
+        "peak_pressure_over_wood_crushing_strength": stage2.peak_contact_pressure_Pa / fc,
+        "log_max_rotation_rad": stage2.log_max_rotation_rad,
+        "log_rotation_limit_rad": ROTATION_LIMIT_RAD,
+        "log_max_strain": stage2.log_max_strain,
+        "log_strain_limit": STRAIN_LIMIT,
+    }
+
+
+MESH_STUDY_COLUMNS = (
+    ("sigma_heel_before_Pa", "heel σ before [MPa]", 1e-6),
+    ("sigma_heel_during_max_Pa", "heel σ max during [MPa]", 1e-6),
+    ("sigma_toe_during_min_Pa", "toe σ min during [MPa]", 1e-6),
+    ("peak_max_principal_stress_near_impact_Pa", "peak σ₁ at offset [MPa]", 1e-6),
+    ("peak_force", "peak force [MN/m or MN]", 1e-6),
+    ("contact_duration_s", "duration [ms]", 1e3),
+    ("impulse", "impulse [kN·s/m or kN·s]", 1e-3),
+    ("peak_contact_pressure_Pa", "peak pressure [MPa]", 1e-6),
+)
+"""(key, heading, scale) of the mesh-study table."""
+
+
+def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None) -> dict:
+    """Stage 1 and stage 2 of ``s`` without output files; the engineer's numbers with the
+    mesh's size. Collective."""
+    from mpi4py import MPI
+
+    from .stage1 import solve_stage1
+    from .stage2 import solve_stage2
+    comm = comm or MPI.COMM_WORLD
+    stage1 = solve_stage1(s, comm=comm)
+    stage2 = solve_stage2(s, stage1, offset_m=impact_offset_m, duration_s=duration_s,
+                          comm=comm)
+    cells = stage1.mesh.msh.topology.index_map(stage1.mesh.msh.topology.dim)
+    row = engineer_numbers(s, stage1, stage2)
+    row.update(refine=s.refine, h_impact_m=s.h_impact_m, h_far_m=s.h_far_m,
+               cells=comm.allreduce(cells.size_local, op=MPI.SUM),
+               time_s=stage1.timings_s["total"] + stage2.timings_s["setup"]
+               + stage2.timings_s["steps"])
+    return row
