@@ -31,6 +31,7 @@ def run(cfg, out=None, check_convergence: bool = False, stream=None) -> dict:
     check_engine(cfg.engine)
     t0 = time.perf_counter()
     prep = prepare(cfg)
+    prep["timings_s"] = {"prepare": time.perf_counter() - t0}
     points, scenarios = prep["points"], prep["scenarios"]
     folder = Path(out or cfg.output["dir"])
     table = ResultTable(folder, cfg.hash(), [point_hash(p) for p in points])
@@ -40,16 +41,21 @@ def run(cfg, out=None, check_convergence: bool = False, stream=None) -> dict:
 
     def on_result(res: dict) -> None:
         i = res["id"]
-        table.append({"id": i, "inputs": points[i], "outputs": res["outputs"],
-                      "counts": res["counts"], "seconds": res["seconds"],
-                      "worker": res["worker"], "dt_s": prep["dt_s"]})
+        row = {"id": i, "inputs": points[i], "outputs": res["outputs"],
+               "counts": res["counts"], "seconds": res["seconds"], "worker": res["worker"],
+               "dt_s": prep["dt_s"]}
+        if "timings_s" in res:
+            row["timings_s"] = res["timings_s"]
+        table.append(row)
         progress.update()
 
+    t1 = time.perf_counter()
     try:
         engines.run(cfg.engine, prep["spec"], tasks, on_result)
     finally:
         progress.close()
         table.close()
+    prep["timings_s"]["compute"] = time.perf_counter() - t1
     return finish(cfg, folder, table, prep, len(tasks), time.perf_counter() - t0,
                   check_convergence)
 
@@ -59,6 +65,7 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
     """results.csv, summary.json, the figures and report.md of a complete table."""
     from ..output import write_summary
     from mpi4py import MPI
+    t0 = time.perf_counter()
     rows = table.sorted_rows()
     inputs = list(cfg.parameters)
     outputs = list(rows[0]["outputs"]) if rows else []
@@ -66,19 +73,38 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
     e = cfg.engine
     run_info = {"config": cfg.source, "config_hash": cfg.hash(), "method": cfg.method,
                 "scenarios": len(prep["scenarios"]), "computed_this_run": computed,
-                "evaluator": e["evaluator"], "engine": e["kind"], "workers": e["workers"],
+                "evaluator": e["evaluator"], "engine": e["kind"],
+                "workers": (1 if e["kind"] == "serial" else
+                            e["workers"] or (engines.default_workers()
+                                             if e["kind"] != "mpi" else None)),
                 "dt_s": prep["dt_s"], "wall_s": wall_s,
                 "seconds_per_scenario_mean": (sum(r["seconds"] for r in rows) / len(rows)
                                               if rows else math.nan),
-                "base": prep["base"].as_dict()}
+                "base": prep["base"].as_dict(),
+                "evaluator_timings_s": _sum_timings(rows)}
     summary = report.summarize(run_info, rows, inputs, outputs, cfg)
+    t_conv = time.perf_counter()
     if check_convergence:
         summary["convergence"] = convergence(prep, summary["worst"])
+    t_conv = time.perf_counter() - t_conv
     summary["figures"] = (report.figures(folder, summary, rows, inputs, outputs)
                           if cfg.output["plots"] and rows else [])
+    summary["timings_s"] = {**prep["timings_s"],
+                            "report": time.perf_counter() - t0 - t_conv,
+                            "convergence": t_conv}
     write_summary(folder, summary, comm=MPI.COMM_SELF)
     (folder / "report.md").write_text(report.markdown(summary, inputs))
     return summary
+
+
+def _sum_timings(rows: list) -> dict:
+    """The evaluators' own timings (s), summed over rows (over workers: CPU-side seconds,
+    not wall time)."""
+    tot = {}
+    for r in rows:
+        for k, v in r.get("timings_s", {}).items():
+            tot[k] = tot.get(k, 0.0) + float(v)
+    return tot
 
 
 def convergence(prep: dict, worst: dict) -> dict:

@@ -12,7 +12,8 @@
 The interface: ``Class(base, dt_s=None, water_levels_m=None, comm=MPI.COMM_SELF)``,
 ``evaluate(scenario) -> dict`` of plain floats, ``counts() -> {"factorizations": {...},
 "back_substitutions": {...}}``; the class's module may define ``sweep_time_step_s(scenarios)``
-(else the monolithic one is used).
+(else the monolithic one is used). Optionally ``timings() -> {phase: seconds}`` (cumulative),
+which the sweep sums like the counts (bench/sweep.py reports its split).
 """
 from __future__ import annotations
 
@@ -79,7 +80,7 @@ _STATE: dict = {}
 def init_worker(spec: EvaluatorSpec) -> None:
     """Build this process's evaluator once (a pool's initializer, or lazily)."""
     _STATE.clear()
-    _STATE.update(spec=spec, evaluator=spec.build(), reported=_zero())
+    _STATE.update(spec=spec, evaluator=spec.build(), reported=_zero(), timed={})
 
 
 def _zero() -> dict:
@@ -105,5 +106,10 @@ def evaluate_task(spec: EvaluatorSpec, task: tuple) -> dict:
     now = ev.counts()
     delta = _delta(now, _STATE["reported"])
     _STATE["reported"] = now
-    return {"id": i, "outputs": outputs, "counts": delta, "seconds": seconds,
-            "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    result = {"id": i, "outputs": outputs, "counts": delta, "seconds": seconds,
+              "worker": f"{socket.gethostname()}:{os.getpid()}"}
+    if hasattr(ev, "timings"):
+        t = {k: float(v) for k, v in ev.timings().items()}
+        result["timings_s"] = {k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()}
+        _STATE["timed"] = t
+    return result

@@ -35,15 +35,20 @@ def envelope_plots(folder: Path, rows: list, inputs: list, outputs: list) -> lis
     paths = []
     for o in outputs:
         y = np.array([float(r["outputs"].get(o, np.nan)) for r in rows])
-        fig, axes = plt.subplots(1, len(inputs), figsize=(3.2 * len(inputs), 3.0),
+        cols = min(3, len(inputs))
+        rows_n = -(-len(inputs) // cols)
+        fig, axes = plt.subplots(rows_n, cols, figsize=(3.4 * cols, 2.8 * rows_n),
                                  squeeze=False, sharey=True)
-        for ax, name in zip(axes[0], inputs):
+        for ax in axes.flat[len(inputs):]:
+            ax.set_visible(False)
+        for ax, name in zip(axes.flat, inputs):
             x = np.array([float(r["inputs"][name]) for r in rows])
             ax.plot(x, y, ".", ms=3, alpha=0.5, label="scenarios")
             ex, ey = envelope(x, y)
             ax.plot(ex, ey, "-", color="C3", label="upper envelope")
             ax.set_xlabel(name)
-        axes[0][0].set_ylabel(o)
+        for row in axes:
+            row[0].set_ylabel(o)
         axes[0][0].legend(fontsize=7)
         fig.suptitle(f"{o}: envelope over the sweep", fontsize=9)
         fig.tight_layout()
