@@ -359,6 +359,11 @@ def test_mpi_futures_engine_gives_the_same_table(tmp_path):
     workers = {json.loads(l)["worker"]
                for l in (tmp_path / "mpi" / "results.jsonl").read_text().splitlines()}
     assert 1 <= len(workers) <= 2  # ranks 1 and 2 computed, rank 0 drove
+    # Without mpi4py.futures every rank would run the sweep: refused, nothing written.
+    with pytest.raises(subprocess.CalledProcessError) as e:
+        mpirun(2, "-m", "flexcontact", "sweep", cfg, "--out", tmp_path / "plain",
+               timeout=300, env={"PYTHONPATH": env_with_fakes()["PYTHONPATH"]})
+    assert "mpi4py.futures" in e.value.stderr and not (tmp_path / "plain").exists()
 
 
 # ---- a real sweep: the monolithic evaluator on the default dam mesh ---------------------

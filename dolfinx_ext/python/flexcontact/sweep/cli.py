@@ -22,9 +22,19 @@ def add_parser(sub) -> None:
 
 
 def main(args) -> int:
+    from mpi4py import MPI
+
     from . import driver
     from .config import load
     from .errors import ConfigError, TableError
+    if MPI.COMM_WORLD.size > 1 and "mpi4py.futures" not in sys.modules:
+        # Every rank would run the whole sweep and write the same table.
+        if MPI.COMM_WORLD.rank == 0:
+            print(f"flexcontact sweep: {MPI.COMM_WORLD.size} MPI ranks run this command; "
+                  f"under mpirun use 'mpirun -n K python3 -m mpi4py.futures -m flexcontact "
+                  f"sweep ... --engine mpi' (rank 0 drives, the others compute)",
+                  file=sys.stderr)
+        return 2
     try:
         cfg = load(args.config)
         for key in ("workers", "scheduler"):
