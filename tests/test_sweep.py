@@ -392,3 +392,19 @@ def test_monolithic_sweep_over_speeds_scales_and_counts(tmp_path):
     assert s["worst"]["peak_force_N_per_m"]["id"] == 1
     assert s["counts"]["factorizations"] == {"stage1": 2, "stage2": 2, "total": 4}
     assert (tmp_path / "out" / "envelope_peak_force_N_per_m.png").stat().st_size > 0
+
+
+def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
+    """The issue's count: over speeds, pitch angles, friction and water levels on one dam
+    mesh and one log geometry, the reusing evaluator factors K (stage 1) and K_eff
+    (stage 2) once each, plus the log's own factorization: three in all, whatever the
+    number of scenarios (serial: one evaluator)."""
+    pytest.importorskip("flexcontact.dam.reuse")
+    raw = {"parameters": {"log_speed_m_s": {"values": [1.5, 3.0]},
+                          "log_pitch_deg": {"values": [5.0, 10.0]},
+                          "friction_mu": {"values": [0.3, 0.6]},
+                          "water_level_m": {"values": [26.0, 27.0]}},
+           "engine": {"evaluator": "reuse", "kind": "serial"}, "output": {"plots": False}}
+    s = sweep.run(sweep.from_dict(raw), out=tmp_path / "out")
+    assert s["scenarios"] == 16
+    assert s["counts"]["factorizations"]["total"] == 3, s["counts"]
