@@ -63,5 +63,14 @@ class LinearEvaluator:
         return {k: dict(v) for k, v in self._counts.items()}
 
 
+class CheckedLinearEvaluator(LinearEvaluator):
+    """A LinearEvaluator that cannot compute speeds above 3.5 m/s (its ``check``)."""
+
+    def check(self, s) -> None:
+        if s.log_speed_m_s > 3.5:
+            raise ValueError(f"log_speed_m_s={s.log_speed_m_s!r}: above this evaluator's "
+                             f"3.5 m/s")
+
+
 def sweep_time_step_s(scenarios):
     return 1e-4

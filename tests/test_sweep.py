@@ -171,6 +171,24 @@ def test_reuse_evaluator_missing_is_a_clear_error(tmp_path):
         sweep.run(sweep.from_dict(raw), out=tmp_path / "out")
 
 
+def test_scenario_the_evaluator_cannot_compute_is_named_before_computing(tmp_path):
+    """An evaluator with a ``check`` (the reusing one refuses a log off its face strip):
+    every scenario is checked by one evaluator before anything is computed."""
+    raw = fake_config(engine={"evaluator": "sweep_fakes:CheckedLinearEvaluator"})
+    cfg = sweep.from_dict(raw)
+    _, points, _ = build_scenarios(cfg)
+    first = next(i for i, p in enumerate(points) if p["log_speed_m_s"] > 3.5)
+    with pytest.raises(ConfigError) as e:
+        sweep.run(cfg, out=tmp_path / "out")
+    v = points[first]["log_speed_m_s"]
+    assert f"scenario {first} (" in str(e.value) and f"log_speed_m_s={v!r}" in str(e.value)
+    assert not (tmp_path / "out").exists()
+    # Below 3.5 m/s it runs; serially the checking evaluator computes, counted once.
+    raw["parameters"]["log_speed_m_s"]["hi"] = 3.5
+    s = sweep.run(sweep.from_dict(raw), out=tmp_path / "ok")
+    assert s["counts"]["factorizations"]["dam"] == 2 and "counts_driver_check" not in s
+
+
 # ---- sampling -----------------------------------------------------------------------------
 
 def test_same_config_same_scenarios_and_latin_hypercube_strata():
@@ -392,6 +410,11 @@ def test_monolithic_sweep_over_speeds_scales_and_counts(tmp_path):
     assert s["worst"]["peak_force_N_per_m"]["id"] == 1
     assert s["counts"]["factorizations"] == {"stage1": 2, "stage2": 2, "total": 4}
     assert (tmp_path / "out" / "envelope_peak_force_N_per_m.png").stat().st_size > 0
+    # The same sweep on two worker processes: the same table (MUMPS and the contact solver
+    # are deterministic for a given matrix).
+    raw["engine"].update(kind="processes", workers=2)
+    sweep.run(sweep.from_dict(raw), out=tmp_path / "processes")
+    same_tables(table_of(tmp_path / "processes"), rows)
 
 
 def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):

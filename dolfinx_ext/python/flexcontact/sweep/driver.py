@@ -7,6 +7,7 @@ from pathlib import Path
 
 from . import engines, evaluators, report
 from .config import check_engine
+from .errors import ConfigError
 from .evaluators import EvaluatorSpec
 from .progress import Progress
 from .scenarios import build_scenarios, point_hash
@@ -18,11 +19,33 @@ def prepare(cfg) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
     import), the sweep's time step and water levels."""
     base, points, scenarios = build_scenarios(cfg)
-    evaluators.resolve(cfg.engine["evaluator"])
+    cls, _ = evaluators.resolve(cfg.engine["evaluator"])
     dt = evaluators.sweep_time_step(cfg.engine["evaluator"], scenarios)
-    levels = tuple(sorted({float(s.water_level_m) for s in scenarios}))
-    spec = EvaluatorSpec(cfg.engine["evaluator"], base, dt, levels)
-    return {"base": base, "points": points, "scenarios": scenarios, "spec": spec, "dt_s": dt}
+    levels = [float(s.water_level_m) for s in scenarios]
+    spec = EvaluatorSpec(cfg.engine["evaluator"], base, dt, (min(levels), max(levels)))
+    prep = {"base": base, "points": points, "scenarios": scenarios, "spec": spec, "dt_s": dt,
+            "checker": None}
+    if hasattr(cls, "check"):
+        prep["checker"] = check_all(spec, points, scenarios)
+    return prep
+
+
+def check_all(spec: EvaluatorSpec, points: list, scenarios: list):
+    """One evaluator of ``spec`` (returned) checks every scenario; ConfigError naming the
+    first it cannot compute, with its inputs."""
+    try:
+        ev = spec.build()
+    except ValueError as e:
+        raise ConfigError(f"engine.evaluator={spec.name!r} cannot be set up for [base]: "
+                          f"{e}") from None
+    for i, (p, s) in enumerate(zip(points, scenarios)):
+        try:
+            ev.check(s)
+        except ValueError as e:
+            inputs = ", ".join(f"parameters.{k}={v!r}" for k, v in p.items())
+            raise ConfigError(f"scenario {i} ({inputs}): {e} (engine.evaluator="
+                              f"{spec.name!r} cannot compute it)") from None
+    return ev
 
 
 def run(cfg, out=None, check_convergence: bool = False, stream=None) -> dict:
@@ -51,7 +74,7 @@ def run(cfg, out=None, check_convergence: bool = False, stream=None) -> dict:
 
     t1 = time.perf_counter()
     try:
-        engines.run(cfg.engine, prep["spec"], tasks, on_result)
+        engines.run(cfg.engine, prep["spec"], tasks, on_result, local=prep["checker"])
     finally:
         progress.close()
         table.close()
@@ -83,6 +106,9 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
                 "base": prep["base"].as_dict(),
                 "evaluator_timings_s": _sum_timings(rows)}
     summary = report.summarize(run_info, rows, inputs, outputs, cfg)
+    if prep["checker"] is not None and e["kind"] != "serial":
+        # The evaluator that checked the scenarios in this process computed none of them.
+        summary["counts_driver_check"] = prep["checker"].counts()
     t_conv = time.perf_counter()
     if check_convergence:
         summary["convergence"] = convergence(prep, summary["worst"])

@@ -25,18 +25,20 @@ def default_workers() -> int:
                else os.cpu_count() or 1)
 
 
-def run(engine: dict, spec, tasks: list, on_result) -> None:
+def run(engine: dict, spec, tasks: list, on_result, local=None) -> None:
     """Evaluate ``tasks`` ((id, scenario) pairs) on ``engine``; ``on_result(result)`` per
-    finished one, in the parent."""
+    finished one, in the parent; ``local``: an evaluator of ``spec`` already built in this
+    process, which the serial engine uses."""
     if not tasks:
         return
     kind = engine["kind"]
     runner = {"serial": _serial, "processes": _processes, "mpi": _mpi, "dask": _dask}[kind]
+    if kind == "serial":
+        init_worker(spec, local)
     runner(engine, spec, tasks, on_result)
 
 
 def _serial(engine, spec, tasks, on_result):
-    init_worker(spec)
     for t in tasks:
         on_result(evaluate_task(spec, t))
 

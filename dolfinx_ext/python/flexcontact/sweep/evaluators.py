@@ -13,7 +13,10 @@ The interface: ``Class(base, dt_s=None, water_levels_m=None, comm=MPI.COMM_SELF)
 ``evaluate(scenario) -> dict`` of plain floats, ``counts() -> {"factorizations": {...},
 "back_substitutions": {...}}``; the class's module may define ``sweep_time_step_s(scenarios)``
 (else the monolithic one is used). Optionally ``timings() -> {phase: seconds}`` (cumulative),
-which the sweep sums like the counts (bench/sweep.py reports its split).
+which the sweep sums like the counts (bench/sweep.py reports its split), and
+``check(scenario)`` raising ValueError for a scenario the evaluator cannot compute (a log
+leaving the face strip a reused dam was meshed for, ...): the sweep then builds one
+evaluator before computing and checks every scenario with it.
 """
 from __future__ import annotations
 
@@ -77,10 +80,11 @@ class EvaluatorSpec:
 _STATE: dict = {}
 
 
-def init_worker(spec: EvaluatorSpec) -> None:
-    """Build this process's evaluator once (a pool's initializer, or lazily)."""
+def init_worker(spec: EvaluatorSpec, evaluator=None) -> None:
+    """Build this process's evaluator once (a pool's initializer, or lazily), or adopt
+    ``evaluator`` (built from ``spec`` already, counts included)."""
     _STATE.clear()
-    _STATE.update(spec=spec, evaluator=spec.build(), reported=_zero(), timed={})
+    _STATE.update(spec=spec, evaluator=evaluator or spec.build(), reported=_zero(), timed={})
 
 
 def _zero() -> dict:

@@ -28,9 +28,10 @@ import dolfinx.fem
 
 from ..dam.stage2 import default_time_step_s
 
-IMPACT_OFFSET_M = 0.5
+IMPACT_OFFSET_M = 1.0
 """Distance from the first-contact point at which the dam's peak largest principal stress
-is read (m), as in demos/dam_debris.py: the corner's own stress grows with refinement."""
+is read (m): solve_stage2's default, and the reusing evaluator's (the corner's own stress
+grows with refinement)."""
 
 OUTPUTS = ("peak_force_N_per_m", "contact_duration_s", "impulse_N_s_per_m",
            "log_momentum_change_N_s_per_m", "heel_stress_static_Pa", "heel_stress_impact_Pa",

@@ -96,6 +96,11 @@ def markdown(summary: dict, inputs: list) -> str:
     for kind in ("factorizations", "back_substitutions"):
         L.append(f"| {kind.replace('_', '-')} | "
                  + " | ".join(str(c[kind].get(k, 0)) for k in keys) + " |")
+    if "counts_driver_check" in s:
+        d = s["counts_driver_check"]
+        L += ["", "Not in these sums: the evaluator the driving process built to check every "
+              f"scenario before computing: factorizations {d['factorizations']}, "
+              f"back-substitutions {d['back_substitutions']}."]
     if s.get("convergence"):
         L += ["", "## Mesh convergence of the most unfavourable scenarios", "",
               "| output | id | refine | value | refine + 1 | value | relative change |",
