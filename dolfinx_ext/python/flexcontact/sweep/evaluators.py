@@ -79,6 +79,10 @@ class EvaluatorSpec:
 
 _STATE: dict = {}
 
+TIMING_OUTPUTS = ("evaluate_s",)
+"""Keys an evaluator may return among its outputs that are wall times, not results: moved
+to the row's timings so that the table is the same whichever engine and machine ran it."""
+
 
 def init_worker(spec: EvaluatorSpec, evaluator=None) -> None:
     """Build this process's evaluator once (a pool's initializer, or lazily), or adopt
@@ -110,10 +114,14 @@ def evaluate_task(spec: EvaluatorSpec, task: tuple) -> dict:
     now = ev.counts()
     delta = _delta(now, _STATE["reported"])
     _STATE["reported"] = now
+    outputs = dict(outputs)
+    timed = {k: float(outputs.pop(k)) for k in TIMING_OUTPUTS if k in outputs}
     result = {"id": i, "outputs": outputs, "counts": delta, "seconds": seconds,
               "worker": f"{socket.gethostname()}:{os.getpid()}"}
     if hasattr(ev, "timings"):
         t = {k: float(v) for k, v in ev.timings().items()}
-        result["timings_s"] = {k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()}
+        timed.update({k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()})
         _STATE["timed"] = t
+    if timed:
+        result["timings_s"] = timed
     return result
