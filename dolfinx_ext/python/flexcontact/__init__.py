@@ -8,6 +8,9 @@ from pathlib import Path as _Path
 _checkout = _Path(__file__).resolve().parents[3]
 if not (_Path(__file__).parent / "forms").is_dir() and (_checkout / "forms" / "elasticity.py").is_file():
     __path__.append(str(_checkout))  # noqa: F821 (a package's own __path__)
+from .petsc_comm import init_for_futures as _init_for_futures
+
+_init_for_futures()  # before anything initialises PETSc: see petsc_comm.py
 from . import _cpp  # noqa: F401  (the compiled kernel and PETSc/MUMPS bridge)
 # Errors users catch: a singular K (a body held by nothing), MUMPS or PETSc failing, no local
 # solver converging. All four are RuntimeErrors.

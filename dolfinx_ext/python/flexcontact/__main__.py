@@ -1,4 +1,5 @@
-"""`python3 -m flexcontact info` prints the stack flexcontact runs on; `demos` lists demos."""
+"""`python3 -m flexcontact info` prints the stack flexcontact runs on; `demos` lists demos;
+`sweep CONFIG.toml` runs a sweep of dam-impact scenarios (docs/dam.md, "Sweeps")."""
 import argparse
 import json
 from pathlib import Path
@@ -11,7 +12,12 @@ def main(argv=None):
     sub = ap.add_subparsers(dest="cmd", required=True)
     sub.add_parser("info", help="versions, MUMPS, the BLAS in use")
     sub.add_parser("demos", help="list the demos and how to run them")
+    from .sweep.cli import add_parser as add_sweep
+    add_sweep(sub)
     args = ap.parse_args(argv)
+    if args.cmd == "sweep":
+        from .sweep.cli import main as sweep
+        raise SystemExit(sweep(args))
     if args.cmd == "info":
         print(json.dumps(describe(), indent=2))
     elif args.cmd == "demos":

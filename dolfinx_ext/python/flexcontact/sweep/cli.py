@@ -1,0 +1,59 @@
+"""The ``sweep`` sub-command of ``python3 -m flexcontact``."""
+from __future__ import annotations
+
+import sys
+
+from .config import ENGINES
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("sweep", help="run (or resume) a sweep of dam-impact scenarios",
+                       description="Run or resume the sweep of a TOML config (docs/dam.md, "
+                                   "'Sweeps'); the table is results.jsonl in the output "
+                                   "folder, resumed if it is there.")
+    p.add_argument("config", help="the sweep's TOML file")
+    p.add_argument("--out", help="output folder (default: output.dir, else "
+                                 "results/sweep/<config stem>)")
+    p.add_argument("--engine", choices=ENGINES, help="overrides engine.kind")
+    p.add_argument("--workers", type=int, help="overrides engine.workers")
+    p.add_argument("--scheduler", help="Dask scheduler address (engine dask)")
+    p.add_argument("--check-convergence", action="store_true",
+                   help="rerun each output's most unfavourable scenario at refine + 1")
+
+
+def main(args) -> int:
+    from mpi4py import MPI
+
+    from . import driver
+    from .config import load
+    from .errors import ConfigError, TableError
+    if MPI.COMM_WORLD.size > 1 and "mpi4py.futures" not in sys.modules:
+        # Every rank would run the whole sweep and write the same table.
+        if MPI.COMM_WORLD.rank == 0:
+            print(f"flexcontact sweep: {MPI.COMM_WORLD.size} MPI ranks run this command; "
+                  f"under mpirun use 'mpirun -n K python3 -m mpi4py.futures -m flexcontact "
+                  f"sweep ... --engine mpi' (rank 0 drives, the others compute)",
+                  file=sys.stderr)
+        return 2
+    try:
+        cfg = load(args.config)
+        for key in ("workers", "scheduler"):
+            if getattr(args, key) is not None:
+                cfg.engine[key] = getattr(args, key)
+        if args.engine:
+            cfg.engine["kind"] = args.engine
+        elif args.scheduler:
+            cfg.engine["kind"] = "dask"
+        summary = driver.run(cfg, out=args.out, check_convergence=args.check_convergence)
+    except (ConfigError, TableError) as e:
+        print(f"flexcontact sweep: {e}", file=sys.stderr)
+        return 2
+    folder = args.out or cfg.output["dir"]
+    print(f"{summary['scenarios']} scenarios, {summary['computed_this_run']} computed in "
+          f"{summary['wall_s']:.1f} s; results in {folder}/ (results.csv, summary.json, "
+          f"report.md)")
+    for o, w in summary["worst"].items():
+        if w is not None:
+            print(f"  worst {o}: {w['value']:.6g} (scenario {w['id']}: "
+                  + ", ".join(f"{k}={v:.4g}" for k, v in w["inputs"].items()) + ")")
+    return 0

@@ -1,0 +1,154 @@
+"""One sweep from a checked config to its table and report (see the package docstring)."""
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+from . import engines, evaluators, report
+from .config import check_engine
+from .errors import ConfigError
+from .evaluators import EvaluatorSpec
+from .progress import Progress
+from .scenarios import build_scenarios, point_hash
+from .stats import KEY_OUTPUTS
+from .table import ResultTable
+
+
+def prepare(cfg) -> dict:
+    """Everything decided before computing: scenarios (all checked), the evaluator (it must
+    import), the sweep's time step and water levels."""
+    base, points, scenarios = build_scenarios(cfg)
+    cls, _ = evaluators.resolve(cfg.engine["evaluator"])
+    dt = evaluators.sweep_time_step(cfg.engine["evaluator"], scenarios)
+    levels = [float(s.water_level_m) for s in scenarios]
+    spec = EvaluatorSpec(cfg.engine["evaluator"], base, dt, (min(levels), max(levels)))
+    prep = {"base": base, "points": points, "scenarios": scenarios, "spec": spec, "dt_s": dt,
+            "checker": None}
+    if hasattr(cls, "check"):
+        prep["checker"] = check_all(spec, points, scenarios)
+    return prep
+
+
+def check_all(spec: EvaluatorSpec, points: list, scenarios: list):
+    """One evaluator of ``spec`` (returned) checks every scenario; ConfigError naming the
+    first it cannot compute, with its inputs."""
+    try:
+        ev = spec.build()
+    except ValueError as e:
+        raise ConfigError(f"engine.evaluator={spec.name!r} cannot be set up for [base]: "
+                          f"{e}") from None
+    for i, (p, s) in enumerate(zip(points, scenarios)):
+        try:
+            ev.check(s)
+        except ValueError as e:
+            inputs = ", ".join(f"parameters.{k}={v!r}" for k, v in p.items())
+            raise ConfigError(f"scenario {i} ({inputs}): {e} (engine.evaluator="
+                              f"{spec.name!r} cannot compute it)") from None
+    return ev
+
+
+def run(cfg, out=None, check_convergence: bool = False, stream=None) -> dict:
+    """Run (or resume) the sweep of ``cfg`` into ``out`` (default ``output.dir``); returns
+    the summary also written to ``summary.json``."""
+    check_engine(cfg.engine)
+    t0 = time.perf_counter()
+    prep = prepare(cfg)
+    prep["timings_s"] = {"prepare": time.perf_counter() - t0}
+    points, scenarios = prep["points"], prep["scenarios"]
+    folder = Path(out or cfg.output["dir"])
+    table = ResultTable(folder, cfg.hash(), [point_hash(p) for p in points])
+    done = table.open()
+    tasks = [(i, s) for i, s in enumerate(scenarios) if i not in done]
+    progress = Progress(len(scenarios), len(done), stream)
+
+    def on_result(res: dict) -> None:
+        i = res["id"]
+        row = {"id": i, "inputs": points[i], "outputs": res["outputs"],
+               "counts": res["counts"], "seconds": res["seconds"], "worker": res["worker"],
+               "dt_s": prep["dt_s"]}
+        if "timings_s" in res:
+            row["timings_s"] = res["timings_s"]
+        table.append(row)
+        progress.update()
+
+    t1 = time.perf_counter()
+    try:
+        engines.run(cfg.engine, prep["spec"], tasks, on_result, local=prep["checker"])
+    finally:
+        progress.close()
+        table.close()
+    prep["timings_s"]["compute"] = time.perf_counter() - t1
+    return finish(cfg, folder, table, prep, len(tasks), time.perf_counter() - t0,
+                  check_convergence)
+
+
+def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wall_s: float,
+           check_convergence: bool) -> dict:
+    """results.csv, summary.json, the figures and report.md of a complete table."""
+    from ..output import write_summary
+    from mpi4py import MPI
+    t0 = time.perf_counter()
+    rows = table.sorted_rows()
+    inputs = list(cfg.parameters)
+    outputs = list(rows[0]["outputs"]) if rows else []
+    table.write_csv(inputs, outputs)
+    e = cfg.engine
+    run_info = {"config": cfg.source, "config_hash": cfg.hash(), "method": cfg.method,
+                "scenarios": len(prep["scenarios"]), "computed_this_run": computed,
+                "evaluator": e["evaluator"], "engine": e["kind"],
+                "workers": (1 if e["kind"] == "serial" else
+                            e["workers"] or (engines.default_workers()
+                                             if e["kind"] != "mpi" else None)),
+                "dt_s": prep["dt_s"], "wall_s": wall_s,
+                "seconds_per_scenario_mean": (sum(r["seconds"] for r in rows) / len(rows)
+                                              if rows else math.nan),
+                "base": prep["base"].as_dict(),
+                "evaluator_timings_s": _sum_timings(rows)}
+    summary = report.summarize(run_info, rows, inputs, outputs, cfg)
+    if prep["checker"] is not None and e["kind"] != "serial":
+        # The evaluator that checked the scenarios in this process computed none of them.
+        summary["counts_driver_check"] = prep["checker"].counts()
+    t_conv = time.perf_counter()
+    if check_convergence:
+        summary["convergence"] = convergence(prep, summary["worst"])
+    t_conv = time.perf_counter() - t_conv
+    summary["figures"] = (report.figures(folder, summary, rows, inputs, outputs)
+                          if cfg.output["plots"] and rows else [])
+    summary["timings_s"] = {**prep["timings_s"],
+                            "report": time.perf_counter() - t0 - t_conv,
+                            "convergence": t_conv}
+    write_summary(folder, summary, comm=MPI.COMM_SELF)
+    (folder / "report.md").write_text(report.markdown(summary, inputs))
+    return summary
+
+
+def _sum_timings(rows: list) -> dict:
+    """The evaluators' own timings (s), summed over rows (over workers: CPU-side seconds,
+    not wall time)."""
+    tot = {}
+    for r in rows:
+        for k, v in r.get("timings_s", {}).items():
+            tot[k] = tot.get(k, 0.0) + float(v)
+    return tot
+
+
+def convergence(prep: dict, worst: dict) -> dict:
+    """Each output's most unfavourable scenario again at refine + 1 (in this process, with
+    an evaluator of its own on the finer base and the sweep's time step)."""
+    spec = prep["spec"]
+    fine = EvaluatorSpec(spec.name, spec.base.replace(refine=spec.base.refine + 1),
+                         spec.dt_s, spec.water_levels_m)
+    ev, cache, out = fine.build(), {}, {}
+    for o in KEY_OUTPUTS:
+        w = worst.get(o)
+        if w is None:
+            continue
+        s = prep["scenarios"][w["id"]]
+        if w["id"] not in cache:
+            cache[w["id"]] = ev.evaluate(s.replace(refine=s.refine + 1))
+        v, v1 = float(w["value"]), float(cache[w["id"]][o])
+        out[o] = {"id": w["id"], "refine": s.refine, "value": v, "value_refined": v1,
+                  "relative_change": (v1 - v) / abs(v) if v else math.nan,
+                  "outputs_refined": cache[w["id"]]}
+    return out

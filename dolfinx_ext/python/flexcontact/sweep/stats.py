@@ -1,0 +1,82 @@
+"""What the engineer reads off a finished table: the most unfavourable scenario of each
+output, its empirical exceedance curve with a bootstrap band, the rank correlation of each
+output with each input, and the factorization counts summed over workers.
+
+The exceedance probability is P[X > x] among the swept scenarios: for a sampled sweep, the
+probability that an impact drawn from the configured distributions exceeds x — conditional
+on an impact happening, not an annual probability.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+KEY_OUTPUTS = ("peak_force_N_per_m", "heel_stress_impact_Pa", "peak_tensile_stress_Pa")
+"""The outputs whose most unfavourable case is reported (largest is worst)."""
+
+
+def column(rows: list, output: str) -> np.ndarray:
+    return np.array([float(r["outputs"].get(output, np.nan)) for r in rows])
+
+
+def worst(rows: list, output: str):
+    """The row with the largest finite value of ``output`` (None if there is none)."""
+    x = column(rows, output)
+    ok = np.isfinite(x)
+    if not ok.any():
+        return None
+    return rows[int(np.flatnonzero(ok)[np.argmax(x[ok])])]
+
+
+def exceedance(values, bootstrap: int, band: float, seed: int) -> dict:
+    """Empirical P[X > x] at the sorted finite values, and its two-sided ``band`` from
+    ``bootstrap`` resamples (numpy Generator of ``seed``), percentiles of the resampled
+    curves at the same x."""
+    x = np.sort(np.asarray(values, float)[np.isfinite(values)])
+    n = x.size
+    if n == 0:
+        return {"x": [], "p": [], "lower": [], "upper": [], "n": 0}
+    p = _survival(x, x)
+    rng = np.random.default_rng(seed)
+    curves = np.empty((bootstrap, n))
+    for b in range(bootstrap):
+        curves[b] = _survival(np.sort(rng.choice(x, size=n, replace=True)), x)
+    q = 100.0 * (1.0 - band) / 2.0
+    lower, upper = np.percentile(curves, [q, 100.0 - q], axis=0)
+    return {"x": x.tolist(), "p": p.tolist(), "lower": lower.tolist(),
+            "upper": upper.tolist(), "n": int(n), "band": band, "bootstrap": bootstrap}
+
+
+def _survival(sample_sorted: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Fraction of the sample strictly greater than each value of ``at``."""
+    n = sample_sorted.size
+    return (n - np.searchsorted(sample_sorted, at, side="right")) / n
+
+
+def spearman(rows: list, inputs: list, outputs: list) -> dict:
+    """{output: {input: Spearman ρ}}; NaN where an input or output is constant."""
+    from scipy.stats import spearmanr
+    out = {}
+    for o in outputs:
+        y = column(rows, o)
+        out[o] = {}
+        for name in inputs:
+            x = np.array([float(r["inputs"][name]) for r in rows])
+            ok = np.isfinite(y)
+            if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
+                out[o][name] = float("nan")
+            else:
+                out[o][name] = float(spearmanr(x[ok], y[ok]).correlation)
+    return out
+
+
+def total_counts(rows: list) -> dict:
+    """Factorizations and back-substitutions summed over rows (each row carries what its
+    worker added, the first row of a worker its set-up too), per stage and in all."""
+    tot = {"factorizations": {}, "back_substitutions": {}}
+    for r in rows:
+        for kind, d in r.get("counts", {}).items():
+            for k, v in d.items():
+                tot[kind][k] = tot[kind].get(k, 0) + int(v)
+    for kind in list(tot):
+        tot[kind]["total"] = sum(v for k, v in tot[kind].items() if k != "total")
+    return tot
