@@ -159,8 +159,8 @@ if comm.rank == 0:
 # so they are at rest until the log arrives. The log's density is raised by the added-mass
 # coefficient, ρ_wood (1 + C_a), and its weight and buoyancy cancel. Contact: the log's
 # front end (its lower front corner touches first) against the face, node–surface with
-# Coulomb friction μ; the pairs are re-made before every step at the current positions
-# (the log slides along the face by much less than an element). Time integration:
+# Coulomb friction μ; the pairs are made once at the initial positions (the log slides
+# along the face by much less than an element). Time integration:
 # Moreau–Jean (θ = ½) on the condensed system, `dt` = 2L/c of the log / 40 by default.
 #
 # What is measured: the contact force per metre of dam against time, its peak, the

@@ -92,7 +92,9 @@ class ImpactProblem:
     solver, flexibility : as for ContactProblem.
 
     Node–surface pairs are re-made before every step but the first (``repair``: B, x0 and
-    W_eff from the stored F̂, no factorization; ``pairings`` counts them).
+    W_eff from the stored F̂, no factorization; ``pairings`` counts them), unless
+    ``repair_pairs`` is False: then the pairs of the initial positions are kept, and the
+    problem stays linear in the initial velocities (an impact of fixed contact geometry).
     ``set_time_step`` changes h (one new factorization; ``factorizations`` counts them).
     ``energy`` is the step-by-step energy account (energy.py), ``records`` one
     ImpactStepRecord per step.
@@ -106,7 +108,8 @@ class ImpactProblem:
                  theta: float = 0.5, mass: str = "consistent",
                  rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
                  solver: Optional[SolverOptions] = None, flexibility: str = "schur",
-                 expected_contact_s: Optional[float] = None, initial_displacement=None):
+                 expected_contact_s: Optional[float] = None, initial_displacement=None,
+                 repair_pairs: bool = True):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)
@@ -137,7 +140,8 @@ class ImpactProblem:
             raise ValueError("contact: a rigid target is not supported by ImpactProblem; "
                              "mesh the obstacle and hold it with Dirichlet conditions")
         # Node–surface pairs follow the bodies: re-made before every step (``repair``).
-        self.repairing = any(i.pairing != "node_to_node" for i in self.interfaces)
+        self.repairing = repair_pairs and any(i.pairing != "node_to_node"
+                                              for i in self.interfaces)
         self.pairings = 1
         self._check_time_step(expected_contact_s)
         self.K, self.M = setup.assemble_matrices(self.a_form, self.m_form, self.bcs, mass,

@@ -47,17 +47,47 @@ def rotate_blocks(W: np.ndarray, R: np.ndarray) -> np.ndarray:
     return np.einsum("ab,ibjc,dc->iajd", R, Wb, R).reshape(W.shape)
 
 
+class LogMesh:
+    """The log's mesh in its own frame with its stiffness K and its unit-density mass M₁,
+    shared by every density of one log geometry: a new density only rescales M (M = ρ M₁),
+    so it costs no meshing and no form compilation (the forms hold no density). Serial."""
+
+    def __init__(self, length_m: float, diameter_m: float, E: float, nu: float,
+                 h_m: float = None, comm=MPI.COMM_SELF):
+        if comm.size != 1:
+            raise ValueError(f"comm of size {comm.size}: LogModel is serial (one rank)")
+        self.length_m, self.diameter_m = float(length_m), float(diameter_m)
+        h = h_m if h_m is not None else diameter_m / 4
+        self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(comm, length_m,
+                                                                         diameter_m, h)
+        self.V = compat.vector_space(self.msh)
+        mat = Material(E_Pa=E, nu=nu, rho_kg_m3=1.0, name="wood")
+        u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
+        dx = ufl.Measure("dx", domain=self.msh)
+        a = dolfinx.fem.form(elasticity_form(u, v, mat, dx, "plane_strain"))
+        m = dolfinx.fem.form(mass_form(u, v, 1.0, dx))
+        n = self.V.dofmap.index_map.size_local * self.V.dofmap.index_map_bs
+        marker = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
+        marker.set(1.0)  # no support: every DOF free
+        self.K, self.M1 = setup.assemble_matrices(a, m, [], "consistent", marker)
+        marker.destroy()
+        self.front = _candidate_surface(self.V, self.facet_tags, T.LOG_FRONT)
+        self.front_dofs = np.asarray(self.front["dofs"], np.int64).reshape(-1)
+        self.x_nodes = self.V.tabulate_dof_coordinates()[:, :2].copy()
+
+
 class LogModel:
     """One log geometry and material at the time step ``dt_s``, factored once.
 
     ``rho_effective_kg_m3``: the wood's density with the added mass of the water,
     ρ (1 + C_a); ``E``, ``nu``: the wood's along-grain modulus (Pa) and Poisson's ratio;
-    ``h_m``: element size (default D/4). Serial.
+    ``h_m``: element size (default D/4); ``mesh``: a :class:`LogMesh` of the same length,
+    diameter, E and ν to reuse (made here when None). Serial.
     """
 
     def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
                  E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
-                 comm=MPI.COMM_SELF):
+                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None):
         if comm.size != 1:
             raise ValueError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
@@ -67,27 +97,23 @@ class LogModel:
         self.dt, self.theta = float(dt_s), float(theta)
         self.factorizations, self.back_substitutions = 0, 0
         t0 = time.perf_counter()
-        h = h_m if h_m is not None else diameter_m / 4
-        self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(comm, length_m,
-                                                                         diameter_m, h)
-        self.V = compat.vector_space(self.msh)
+        self.mesh = mesh if mesh is not None else LogMesh(length_m, diameter_m, E, nu, h_m, comm)
+        self.msh, self.cell_tags, self.facet_tags = (self.mesh.msh, self.mesh.cell_tags,
+                                                     self.mesh.facet_tags)
+        self.V = self.mesh.V
         self._factor()
-        self.front = _candidate_surface(self.V, self.facet_tags, T.LOG_FRONT)
-        self.front_dofs = np.asarray(self.front["dofs"], np.int64).reshape(-1)
+        self.front, self.front_dofs = self.mesh.front, self.mesh.front_dofs
         F, self.factor, info = _cpp.flexibility(self.W_hat, self.front_dofs, "schur")
         self.W_front = np.asarray(F)
         self.factorizations += int(info["factorizations"])
         self.setup_s = time.perf_counter() - t0
 
     def _factor(self):
-        V, mat = self.V, self.material
-        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-        dx = ufl.Measure("dx", domain=self.msh)
-        a = dolfinx.fem.form(elasticity_form(u, v, mat, dx, "plane_strain"))
-        m = dolfinx.fem.form(mass_form(u, v, mat.rho_kg_m3, dx))
+        self.K = self.mesh.K
+        self.M = self.mesh.M1.copy()
+        self.M.scale(self.material.rho_kg_m3)
         marker = self.new_vector()
         marker.set(1.0)
-        self.K, self.M = setup.assemble_matrices(a, m, [], "consistent", marker)
         self.W_hat = setup.iteration_matrix(self.K, self.M, self.dt, self.theta, (0.0, 0.0),
                                             marker)
         ones = [self.new_vector() for _ in range(2)]
@@ -99,7 +125,7 @@ class LogModel:
         self._rigid = ones
         for o in (marker, Mo):
             o.destroy()
-        self.x_nodes = V.tabulate_dof_coordinates()[:, :2].copy()
+        self.x_nodes = self.mesh.x_nodes
 
     def new_vector(self) -> PETSc.Vec:
         if hasattr(self, "K"):

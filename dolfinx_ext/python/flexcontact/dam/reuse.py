@@ -26,7 +26,7 @@ from mpi4py import MPI
 from .. import impact_setup as setup
 from .coupled_step import expected_contact_s, run_impact
 from .dam_model import DamModel
-from .log_model import LogModel
+from .log_model import LogMesh, LogModel
 from .stage2 import default_time_step_s
 
 DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
@@ -90,6 +90,7 @@ class ScenarioEvaluator:
         self.dam = DamModel(base, self.dt, water_levels_m, comm, strip_m=strip_m)
         self.dam.static_state(base.water_level_m)
         self._logs: dict = {}
+        self._log_meshes: dict = {}  # a log geometry's mesh, K and unit mass, every density
         self.setup_s = time.perf_counter() - t0
 
     def check(self, scenario) -> None:
@@ -115,9 +116,14 @@ class ScenarioEvaluator:
         """The cached LogModel of the scenario's log (made on first use)."""
         key = log_key(s)
         if key not in self._logs:
+            geometry = (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu)
+            if geometry not in self._log_meshes:
+                self._log_meshes[geometry] = LogMesh(*geometry, h_m=self.base.h_impact_m,
+                                                     comm=self.dam.comm)
             self._logs[key] = LogModel(
                 s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
-                s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm)
+                s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm,
+                mesh=self._log_meshes[geometry])
         return self._logs[key]
 
     def evaluate(self, scenario) -> dict:
