@@ -40,7 +40,7 @@ std::vector<int> metis_pivot_order(Mat K, std::span<const PetscInt> last);
 
 /// @brief Redo MUMPS's analysis of the factor F (after MatCholeskyFactorSymbolic) with the
 /// ordering `icntl7`, and PERM_IN = `perm_in` when icntl7 = 1. Serial only.
-/// @throws std::runtime_error if F's MUMPS instance is not as expected or the ordering
-/// was not used
+/// @throws std::runtime_error if F's MUMPS instance is not as expected or PERM_IN was not
+/// used (MUMPS may replace its own orderings: with a Schur complement AMF, PORD, QAMD by AMD)
 void reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm_in);
 } // namespace flexcontact

@@ -11,11 +11,18 @@ FlexibilityMethod = Literal["schur", "inverse_entries", "matmatsolve"]
 """How F* = (K⁻¹)_cc is computed: MUMPS Schur complement (on several ranks it runs as
 "inverse_entries"), MUMPS selected inverse entries, or a multi-right-hand-side solve."""
 
+Ordering = Literal["metis", "mumps", "amd", "amf", "pord", "qamd"]
+"""The fill-reducing ordering of the MUMPS factorization of K: "metis" (METIS nested
+dissection of the mesh nodes handed to MUMPS; the default, fewest flops and entries in 2D
+and 3D, bench/ordering.py), "mumps" (MUMPS's automatic choice among what Debian's MUMPS has),
+or MUMPS's "amd", "amf", "pord", "qamd". On several ranks MUMPS's automatic choice is used."""
+
 SolverName = Literal["newton_ac", "active_set", "projection"]
 """Local contact solvers of ``SolverOptions.chain``: semi-smooth Newton on Alart–Curnier,
 the Feng–Touzot active set, the De Saxcé–Feng projection."""
 
 FLEXIBILITY_METHODS: tuple[str, ...] = get_args(FlexibilityMethod)
+ORDERINGS: tuple[str, ...] = get_args(Ordering)
 SOLVER_NAMES: tuple[str, ...] = get_args(SolverName)
 
 
@@ -25,6 +32,13 @@ def check_flexibility_method(method: str) -> FlexibilityMethod:
         raise ValueError(f"unknown flexibility method {method!r}; "
                          f"allowed: {', '.join(FLEXIBILITY_METHODS)}")
     return method
+
+
+def check_ordering(ordering: str) -> Ordering:
+    """``ordering`` itself if it is a factorization ordering; ValueError naming it otherwise."""
+    if ordering not in ORDERINGS:
+        raise ValueError(f"unknown ordering {ordering!r}; allowed: {', '.join(ORDERINGS)}")
+    return ordering
 
 
 def check_chain(chain: Iterable[str]) -> list[SolverName]:
