@@ -78,4 +78,32 @@ part of factorization_s), factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
 factor_memory_mb (INFOG(22)).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
+
+  m.def(
+      "factor_analysis",
+      [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
+         const std::string& ordering)
+      {
+        std::span<const std::int64_t> dofs(contact_dofs.data(), contact_dofs.size());
+        Flexibility r;
+        {
+          py::gil_scoped_release release;
+          r = factor_analysis(K, dofs, ordering);
+        }
+        py::dict info;
+        info["ordering"] = r.ordering;
+        info["mumps_ordering"] = r.mumps_ordering;
+        info["n_contact_dofs"] = r.n_contact_dofs;
+        info["estimated_entries"] = r.factor_entries;
+        info["estimated_flops"] = r.factor_flops;
+        info["estimated_memory_mb"] = r.factor_memory_mb;
+        info["analysis_s"] = r.factorization_s;
+        info["ordering_s"] = r.ordering_s;
+        return info;
+      },
+      py::arg("K"), py::arg("contact_dofs"), py::arg("ordering") = "metis",
+      R"(MUMPS's analysis alone (one process): what factoring K with `ordering` (as in
+flexibility) and a Schur complement on contact_dofs (none if empty) would cost. Returns a
+dict: ordering, mumps_ordering (INFOG(7)), n_contact_dofs, estimated_entries (INFOG(20)),
+estimated_flops (RINFOG(1)), estimated_memory_mb (INFOG(17)), analysis_s, ordering_s.)");
 }

@@ -117,13 +117,30 @@ void factor_statistics(PetscErrorScope& err, Mat F, Flexibility& out)
   out.factor_memory_mb = static_cast<int>(infog22);
 }
 
+/// @brief What MUMPS's analysis expects of the factorization (INFOG(20), RINFOG(1),
+/// INFOG(17)), in the fields factor_statistics() fills after it.
+void analysis_estimates(PetscErrorScope& err, Mat F, Flexibility& out)
+{
+  PetscInt infog7 = 0, infog20 = 0, infog17 = 0;
+  PetscReal flops = 0;
+  err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
+  err.check(MatMumpsGetInfog(F, 20, &infog20), "MatMumpsGetInfog(20)");
+  err.check(MatMumpsGetInfog(F, 17, &infog17), "MatMumpsGetInfog(17)");
+  err.check(MatMumpsGetRinfog(F, 1, &flops), "MatMumpsGetRinfog(1)");
+  out.mumps_ordering = ordering_name(static_cast<int>(infog7));
+  out.factor_entries = infog20 >= 0 ? static_cast<std::int64_t>(infog20)
+                                    : -static_cast<std::int64_t>(infog20) * 1000000;
+  out.factor_flops = flops;
+  out.factor_memory_mb = static_cast<int>(infog17);
+}
+
 /// @brief MUMPS Cholesky of K with the fill-reducing `ordering` (ordering.h; serial unless
 /// "mumps"), optionally with a centralised Schur complement on `schur` (rank 0's indices;
 /// empty elsewhere). Returns the factored matrix; sets out.null_pivots, out.ordering and the
 /// factor's statistics, and counts in out.factorization_retries the factorizations that ran
 /// out of MUMPS workspace and were redone.
 Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
-              const std::string& ordering, Flexibility& out)
+              const std::string& ordering, Flexibility& out, bool analysis_only = false)
 {
   int& retries = out.factorization_retries;
   // K is factored as symmetric indefinite (LDLᵀ with pivoting), and in parallel MUMPS's
@@ -170,6 +187,11 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
       double t1 = MPI_Wtime();
       reanalyse(F.m, N, icntl7, perm_in);
       out.ordering_s += MPI_Wtime() - t1;
+    }
+    if (analysis_only)
+    {
+      analysis_estimates(err, F.m, out);
+      return F.release();
     }
     err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
     err.check(MatCholeskyFactorNumeric(F.m, K, &info), "MatCholeskyFactorNumeric");
@@ -501,5 +523,35 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   out.factorization_s = t[0];
   out.schur_s = t[1];
   out.inverse_s = t[2];
+  return out;
+}
+
+Flexibility flexcontact::factor_analysis(Mat K, std::span<const std::int64_t> contact_dofs,
+                                         const std::string& ordering)
+{
+  if (!is_ordering(ordering))
+    throw std::invalid_argument("unknown ordering '" + ordering
+                                + "' (expected 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
+  PetscErrorScope err;
+  MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  if (size > 1)
+    throw std::invalid_argument("factor_analysis runs on one process only");
+  PetscInt N = 0;
+  err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
+  std::vector<PetscInt> dofs(contact_dofs.begin(), contact_dofs.end());
+  for (PetscInt d : dofs)
+    if (d < 0 or d >= N)
+      throw std::invalid_argument("contact DOF out of range [0, " + std::to_string(N)
+                                  + "): " + std::to_string(d));
+  err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
+  Flexibility out;
+  out.ordering = ordering;
+  out.n_contact_dofs = static_cast<int>(dofs.size());
+  double t0 = MPI_Wtime();
+  OwnedMat F;
+  F.m = factorize(err, K, dofs.empty() ? nullptr : &dofs, ordering, out, true);
+  out.factorization_s = MPI_Wtime() - t0;
   return out;
 }

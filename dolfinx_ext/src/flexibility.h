@@ -91,4 +91,11 @@ struct Flexibility
 Flexibility flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
                         const std::string& method = "schur",
                         const std::string& ordering = "metis");
+
+/// @brief MUMPS's analysis only (serial): what the factorization of K with `ordering` and a
+/// Schur complement on `contact_dofs` (none if empty) would cost, without factorizing. In the
+/// returned value factor_entries is INFOG(20), factor_flops RINFOG(1), factor_memory_mb
+/// INFOG(17) (MUMPS's estimates), factorization_s the analysis time; F and factor are empty.
+Flexibility factor_analysis(Mat K, std::span<const std::int64_t> contact_dofs,
+                            const std::string& ordering);
 } // namespace flexcontact
