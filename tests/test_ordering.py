@@ -88,4 +88,14 @@ def test_unknown_ordering_raises():
         fc.flexibility(K, np.array([0], np.int64), "schur", "nd")
     with pytest.raises(ValueError, match="unknown ordering 'scotch'"):
         check_ordering("scotch")
-    assert set(ORDERINGS) == {"mumps", *ORDERED}
+    assert set(ORDERINGS) == {"auto", "mumps", *ORDERED}
+
+
+@pytest.mark.parametrize("dim,n,expected", [(3, 3, "metis"), (2, 6, "mumps")])
+def test_auto_is_metis_in_3d_only(dim, n, expected):
+    """The default "auto" orders 3D elasticity (block size 3) with METIS, 2D with MUMPS."""
+    msh, V, K, tags = elasticity(n, dim)
+    _, dofs = contact_dofs(V, tags)
+    _, _, info = fc.flexibility(K, dofs)
+    assert info["ordering"] == expected
+    assert (info["mumps_ordering"] == "metis") == (expected == "metis")

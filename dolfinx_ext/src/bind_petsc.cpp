@@ -55,7 +55,7 @@ void flexcontact::bind_petsc(py::module& m)
         return py::make_tuple(F, factor, info);
       },
       py::arg("K"), py::arg("contact_dofs"), py::arg("method") = "schur",
-      py::arg("ordering") = "metis",
+      py::arg("ordering") = "auto",
       R"(Flexibility F* = (K^-1)_cc on the contact DOFs from one MUMPS Cholesky factorization.
 
 Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); contact_dofs
@@ -64,10 +64,11 @@ complement K*_cc inside the factorization, then F* = inv(K*_cc) by dense Cholesk
 "inverse_entries" (MUMPS computes the requested entries of inv(K), ICNTL(30)) or
 "matmatsolve" (solve K X = E_c for the contact unit vectors). PETSc cannot solve with a
 Schur factor in parallel, so there "schur" runs as "inverse_entries"; info["method"] tells.
-ordering: MUMPS's fill-reducing ordering, "metis" (METIS nested dissection of the nodal
-graph handed to MUMPS, the default), "mumps" (MUMPS's automatic choice; Debian's MUMPS has
-AMD, AMF, PORD, QAMD), or one of "amd", "amf", "pord", "qamd"; on several ranks MUMPS's
-automatic choice is used (info["ordering"] tells).
+ordering: MUMPS's fill-reducing ordering, "auto" (the default: "metis" for K of block size
+3, 3D elasticity; "mumps" otherwise), "metis" (METIS nested dissection of the nodal graph
+handed to MUMPS), "mumps" (MUMPS's automatic choice; Debian's MUMPS has AMD, AMF, PORD,
+QAMD), or one of "amd", "amf", "pord", "qamd"; on several ranks MUMPS's automatic choice is
+used (info["ordering"] tells the one asked of MUMPS, "auto" resolved).
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
 factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; info:
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
@@ -101,7 +102,7 @@ solver failures, ValueError on bad arguments. Collective.)");
         info["ordering_s"] = r.ordering_s;
         return info;
       },
-      py::arg("K"), py::arg("contact_dofs"), py::arg("ordering") = "metis",
+      py::arg("K"), py::arg("contact_dofs"), py::arg("ordering") = "auto",
       R"(MUMPS's analysis alone (one process): what factoring K with `ordering` (as in
 flexibility) and a Schur complement on contact_dofs (none if empty) would cost. Returns a
 dict: ordering, mumps_ordering (INFOG(7)), n_contact_dofs, estimated_entries (INFOG(20)),

@@ -435,7 +435,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
                                 + "' (expected 'schur', 'inverse_entries' or 'matmatsolve')");
   if (!is_ordering(ordering))
     throw std::invalid_argument("unknown ordering '" + ordering
-                                + "' (expected 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
+                                + "' (expected 'auto', 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
   if (!K)
     throw std::invalid_argument("the stiffness matrix is a null Mat");
 
@@ -480,7 +480,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   out.method = used;
   // A given ordering is set by redoing MUMPS's analysis on rank 0's instance (ordering.h);
   // on several ranks MUMPS's automatic choice stays.
-  out.ordering = size > 1 ? "mumps" : ordering;
+  out.ordering = size > 1 ? "mumps" : resolve_ordering(ordering, K);
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
 
@@ -531,7 +531,7 @@ Flexibility flexcontact::factor_analysis(Mat K, std::span<const std::int64_t> co
 {
   if (!is_ordering(ordering))
     throw std::invalid_argument("unknown ordering '" + ordering
-                                + "' (expected 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
+                                + "' (expected 'auto', 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
   PetscErrorScope err;
   MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
   int size = 1;
@@ -547,11 +547,11 @@ Flexibility flexcontact::factor_analysis(Mat K, std::span<const std::int64_t> co
                                   + "): " + std::to_string(d));
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
   Flexibility out;
-  out.ordering = ordering;
+  out.ordering = resolve_ordering(ordering, K);
   out.n_contact_dofs = static_cast<int>(dofs.size());
   double t0 = MPI_Wtime();
   OwnedMat F;
-  F.m = factorize(err, K, dofs.empty() ? nullptr : &dofs, ordering, out, true);
+  F.m = factorize(err, K, dofs.empty() ? nullptr : &dofs, out.ordering, out, true);
   out.factorization_s = MPI_Wtime() - t0;
   return out;
 }

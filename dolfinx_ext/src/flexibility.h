@@ -51,7 +51,8 @@ struct Flexibility
   double schur_s = 0;            ///< extracting K*_cc (schur), the selected-inverse solve
                                  ///< (inverse_entries) or the multi-RHS solve (matmatsolve)
   double inverse_s = 0;          ///< dense Cholesky inversion of K*_cc (schur only)
-  std::string ordering;          ///< ordering requested of MUMPS ("mumps" on several ranks)
+  std::string ordering;          ///< ordering requested of MUMPS, "auto" resolved ("mumps" on
+                                 ///< several ranks)
   std::string mumps_ordering;    ///< ordering MUMPS used, from INFOG(7) ("metis" for ours)
   double ordering_s = 0;         ///< METIS and the redone analysis (within factorization_s)
   std::int64_t factor_entries = 0; ///< entries in the factor, INFOG(29)
@@ -82,15 +83,16 @@ struct Flexibility
 /// @param K assembled stiffness (MATAIJ family)
 /// @param contact_dofs global row indices of the contact DOFs, on rank 0 (ignored elsewhere)
 /// @param method "schur", "inverse_entries" or "matmatsolve"
-/// @param ordering fill-reducing ordering (ordering.h): "metis" (nested dissection of the
-///   nodal graph, the Schur variables last), "mumps" (MUMPS's automatic choice), "amd",
-///   "amf", "pord" or "qamd"; on several ranks MUMPS's automatic choice is used
+/// @param ordering fill-reducing ordering (ordering.h): "auto" ("metis" for 3D elasticity,
+///   "mumps" otherwise), "metis" (nested dissection of the nodal graph, the Schur variables
+///   last), "mumps" (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd"; on several
+///   ranks MUMPS's automatic choice is used
 /// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
 /// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)
 /// @throws MumpsError on a MUMPS failure, PetscError on a PETSc failure
 Flexibility flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
                         const std::string& method = "schur",
-                        const std::string& ordering = "metis");
+                        const std::string& ordering = "auto");
 
 /// @brief MUMPS's analysis only (serial): what the factorization of K with `ordering` and a
 /// Schur complement on `contact_dofs` (none if empty) would cost, without factorizing. In the

@@ -68,8 +68,18 @@ void nodal_graph(Mat K, PetscInt bs, std::vector<idx_t>& xadj, std::vector<idx_t
 
 bool flexcontact::is_ordering(const std::string& name)
 {
-  return std::any_of(kOrderings.begin(), kOrderings.end(),
+  return name == "auto" or std::any_of(kOrderings.begin(), kOrderings.end(),
                      [&name](const auto& o) { return name == o.first; });
+}
+
+std::string flexcontact::resolve_ordering(const std::string& name, Mat K)
+{
+  if (name != "auto")
+    return name;
+  PetscInt bs = 1;
+  PetscErrorScope err;
+  err.check(MatGetBlockSize(K, &bs), "MatGetBlockSize");
+  return bs == 3 ? "metis" : "mumps";
 }
 
 int flexcontact::mumps_icntl7(const std::string& name)
@@ -78,7 +88,7 @@ int flexcontact::mumps_icntl7(const std::string& name)
     if (name == n)
       return v;
   throw std::invalid_argument("unknown ordering '" + name
-                              + "' (expected 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
+                              + "' (expected 'auto', 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
 }
 
 std::string flexcontact::ordering_name(int infog7)

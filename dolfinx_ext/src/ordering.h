@@ -21,12 +21,18 @@
 
 namespace flexcontact
 {
-/// @brief The orderings flexibility() accepts: "metis" (METIS nested dissection given to
-/// MUMPS), "mumps" (MUMPS's automatic choice, ICNTL(7) = 7), and MUMPS's own "amd", "amf",
-/// "pord", "qamd" (ICNTL(7) = 0, 2, 4, 6).
+/// @brief The orderings flexibility() accepts: "auto" (see resolve_ordering), "metis" (METIS
+/// nested dissection given to MUMPS), "mumps" (MUMPS's automatic choice, ICNTL(7) = 7), and
+/// MUMPS's own "amd", "amf", "pord", "qamd" (ICNTL(7) = 0, 2, 4, 6).
 bool is_ordering(const std::string& name);
 
-/// @brief MUMPS's ICNTL(7) for a MUMPS ordering name ("mumps" → 7, "amd" → 0, ...); 1 for
+/// @brief The ordering "auto" stands for: "metis" for K of block size 3 (3D elasticity,
+/// where METIS needs 2.7 times fewer flops than MUMPS's choice at 30k DOFs), "mumps"
+/// otherwise (in 2D METIS saves flops too, but at 200k DOFs ordering costs more time than it
+/// saves; bench/ordering.py). Other names are returned as they are.
+std::string resolve_ordering(const std::string& name, Mat K);
+
+/// @brief MUMPS's ICNTL(7) for a resolved ordering name ("mumps" → 7, "amd" → 0, ...); 1 for
 /// "metis" (a user permutation).
 int mumps_icntl7(const std::string& name);
 

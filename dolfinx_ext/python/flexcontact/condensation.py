@@ -48,7 +48,7 @@ class Condensation:
 
     def __init__(self, K: PETSc.Mat, bcs: Sequence, pairs: Optional[NodePairs],
                  mu: np.ndarray, dim: int, comm, options, method: str,
-                 kernel: Optional[Callable] = None, ordering: str = "metis"):
+                 kernel: Optional[Callable] = None, ordering: str = "auto"):
         self.comm = comm
         root = comm.rank == 0
         self.pairs = pairs

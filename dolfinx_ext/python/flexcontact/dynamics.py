@@ -99,7 +99,8 @@ class ImpactProblem:
                  theta: float = 0.5, mass: str = "consistent",
                  rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
                  solver: Optional[SolverOptions] = None, flexibility: str = "schur",
-                 ordering: str = "metis", expected_contact_s: Optional[float] = None, initial_displacement=None):
+                 ordering: str = "auto", expected_contact_s: Optional[float] = None,
+                 initial_displacement=None):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)

@@ -145,9 +145,10 @@ class ContactProblem:
         that factor, so MUMPS selected inverse entries are used: "inverse_entries"),
         "inverse_entries", or "matmatsolve" (a multi-right-hand-side solve, the reference).
         Each makes one sparse factorization, which then serves every solve.
-    ordering : fill-reducing ordering of that factorization: "metis" (default; METIS
-        nested dissection handed to MUMPS), "mumps" (MUMPS's automatic choice), "amd",
-        "amf", "pord" or "qamd" (names.Ordering; bench/ordering.py compares them).
+    ordering : fill-reducing ordering of that factorization: "auto" (default: "metis" in
+        3D, "mumps" in 2D), "metis" (METIS nested dissection handed to MUMPS), "mumps"
+        (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd" (names.Ordering;
+        bench/ordering.py compares them).
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
@@ -160,7 +161,7 @@ class ContactProblem:
                  contact: Union[ContactInterface, Sequence[ContactInterface]], *,
                  bodies: Optional[tuple[MeshTags, dict[str, int]]] = None,
                  stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
-                 flexibility: FlexibilityMethod = "schur", ordering: Ordering = "metis"):
+                 flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto"):
         check_flexibility_method(flexibility)
         check_ordering(ordering)
         if solver is not None:
