@@ -13,7 +13,7 @@ packages=(
   python3-dolfinx libdolfinx-dev petsc-dev python3-petsc4py python3-mpi4py openmpi-bin
   gmsh python3-gmsh libeigen3-dev pybind11-dev
   googletest libgtest-dev python3-pytest python3-scipy python3-matplotlib python3-tqdm
-  python3-distributed
+  python3-distributed libmetis-dev libmumps-dev
   libopenblas0-serial
 )
 # Peer codes used as oracles by some tests; a distribution without them (Debian 13 has no

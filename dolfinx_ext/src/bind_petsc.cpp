@@ -27,13 +27,13 @@ void flexcontact::bind_petsc(py::module& m)
   m.def(
       "flexibility",
       [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
-         const std::string& method)
+         const std::string& method, const std::string& ordering)
       {
         std::span<const std::int64_t> dofs(contact_dofs.data(), contact_dofs.size());
         Flexibility r;
         {
           py::gil_scoped_release release;
-          r = flexibility(K, dofs, method);
+          r = flexibility(K, dofs, method, ordering);
         }
         py::dict info;
         info["method"] = r.method;
@@ -44,11 +44,18 @@ void flexcontact::bind_petsc(py::module& m)
         info["factorization_s"] = r.factorization_s;
         info["schur_s"] = r.schur_s;
         info["inverse_s"] = r.inverse_s;
+        info["ordering"] = r.ordering;
+        info["mumps_ordering"] = r.mumps_ordering;
+        info["ordering_s"] = r.ordering_s;
+        info["factor_entries"] = r.factor_entries;
+        info["factor_flops"] = r.factor_flops;
+        info["factor_memory_mb"] = r.factor_memory_mb;
         py::object factor = py::cast(r.factor, py::return_value_policy::take_ownership);
         py::array_t<double> F = py::cast(r.F);
         return py::make_tuple(F, factor, info);
       },
       py::arg("K"), py::arg("contact_dofs"), py::arg("method") = "schur",
+      py::arg("ordering") = "auto",
       R"(Flexibility F* = (K^-1)_cc on the contact DOFs from one MUMPS Cholesky factorization.
 
 Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); contact_dofs
@@ -57,11 +64,47 @@ complement K*_cc inside the factorization, then F* = inv(K*_cc) by dense Cholesk
 "inverse_entries" (MUMPS computes the requested entries of inv(K), ICNTL(30)) or
 "matmatsolve" (solve K X = E_c for the contact unit vectors). PETSc cannot solve with a
 Schur factor in parallel, so there "schur" runs as "inverse_entries"; info["method"] tells.
+ordering: MUMPS's fill-reducing ordering, "auto" (the default: "metis" for K of block size
+3, 3D elasticity; "mumps" otherwise), "metis" (METIS nested dissection of the nodal graph
+handed to MUMPS), "mumps" (MUMPS's automatic choice; Debian's MUMPS has AMD, AMF, PORD,
+QAMD), or one of "amd", "amf", "pord", "qamd"; on several ranks MUMPS's automatic choice is
+used (info["ordering"] tells the one asked of MUMPS, "auto" resolved).
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
 factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; info:
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
 workspace), factorization_s,
-schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s.
+schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s, ordering
+(requested), mumps_ordering (used, INFOG(7)), ordering_s (METIS and the redone analysis,
+part of factorization_s), factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
+factor_memory_mb (INFOG(22)).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
+
+  m.def(
+      "factor_analysis",
+      [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
+         const std::string& ordering)
+      {
+        std::span<const std::int64_t> dofs(contact_dofs.data(), contact_dofs.size());
+        Flexibility r;
+        {
+          py::gil_scoped_release release;
+          r = factor_analysis(K, dofs, ordering);
+        }
+        py::dict info;
+        info["ordering"] = r.ordering;
+        info["mumps_ordering"] = r.mumps_ordering;
+        info["n_contact_dofs"] = r.n_contact_dofs;
+        info["estimated_entries"] = r.factor_entries;
+        info["estimated_flops"] = r.factor_flops;
+        info["estimated_memory_mb"] = r.factor_memory_mb;
+        info["analysis_s"] = r.factorization_s;
+        info["ordering_s"] = r.ordering_s;
+        return info;
+      },
+      py::arg("K"), py::arg("contact_dofs"), py::arg("ordering") = "auto",
+      R"(MUMPS's analysis alone (one process): what factoring K with `ordering` (as in
+flexibility) and a Schur complement on contact_dofs (none if empty) would cost. Returns a
+dict: ordering, mumps_ordering (INFOG(7)), n_contact_dofs, estimated_entries (INFOG(20)),
+estimated_flops (RINFOG(1)), estimated_memory_mb (INFOG(17)), analysis_s, ordering_s.)");
 }

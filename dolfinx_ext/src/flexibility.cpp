@@ -1,6 +1,7 @@
 // Copyright flexcontact developers. MIT licence.
 
 #include "flexibility.h"
+#include "ordering.h"
 #include "petsc_error.h"
 
 #include <algorithm>
@@ -99,12 +100,49 @@ int check_null_pivots(PetscErrorScope& err, Mat F)
   return static_cast<int>(n);
 }
 
-/// @brief MUMPS Cholesky of K, optionally with a centralised Schur complement on `schur`
-/// (rank 0's indices; empty elsewhere). Returns the factored matrix; `retries` counts the
-/// factorizations that ran out of MUMPS workspace and were redone.
-Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, int& null_pivots,
-              int& retries)
+/// @brief The ordering MUMPS used and the size and cost of its factor (global INFOG/RINFOG).
+void factor_statistics(PetscErrorScope& err, Mat F, Flexibility& out)
 {
+  PetscInt infog7 = 0, infog29 = 0, infog22 = 0;
+  PetscReal flops = 0;
+  err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
+  err.check(MatMumpsGetInfog(F, 29, &infog29), "MatMumpsGetInfog(29)");
+  err.check(MatMumpsGetInfog(F, 22, &infog22), "MatMumpsGetInfog(22)");
+  err.check(MatMumpsGetRinfog(F, 3, &flops), "MatMumpsGetRinfog(3)");
+  out.mumps_ordering = ordering_name(static_cast<int>(infog7));
+  // INFOG(29) < 0 counts millions of entries
+  out.factor_entries = infog29 >= 0 ? static_cast<std::int64_t>(infog29)
+                                    : -static_cast<std::int64_t>(infog29) * 1000000;
+  out.factor_flops = flops;
+  out.factor_memory_mb = static_cast<int>(infog22);
+}
+
+/// @brief What MUMPS's analysis expects of the factorization (INFOG(20), RINFOG(1),
+/// INFOG(17)), in the fields factor_statistics() fills after it.
+void analysis_estimates(PetscErrorScope& err, Mat F, Flexibility& out)
+{
+  PetscInt infog7 = 0, infog20 = 0, infog17 = 0;
+  PetscReal flops = 0;
+  err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
+  err.check(MatMumpsGetInfog(F, 20, &infog20), "MatMumpsGetInfog(20)");
+  err.check(MatMumpsGetInfog(F, 17, &infog17), "MatMumpsGetInfog(17)");
+  err.check(MatMumpsGetRinfog(F, 1, &flops), "MatMumpsGetRinfog(1)");
+  out.mumps_ordering = ordering_name(static_cast<int>(infog7));
+  out.factor_entries = infog20 >= 0 ? static_cast<std::int64_t>(infog20)
+                                    : -static_cast<std::int64_t>(infog20) * 1000000;
+  out.factor_flops = flops;
+  out.factor_memory_mb = static_cast<int>(infog17);
+}
+
+/// @brief MUMPS Cholesky of K with the fill-reducing `ordering` (ordering.h; serial unless
+/// "mumps"), optionally with a centralised Schur complement on `schur` (rank 0's indices;
+/// empty elsewhere). Returns the factored matrix; sets out.null_pivots, out.ordering and the
+/// factor's statistics, and counts in out.factorization_retries the factorizations that ran
+/// out of MUMPS workspace and were redone.
+Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
+              const std::string& ordering, Flexibility& out, bool analysis_only = false)
+{
+  int& retries = out.factorization_retries;
   // K is factored as symmetric indefinite (LDLᵀ with pivoting), and in parallel MUMPS's
   // dynamic scheduling depends on the load of the machine: the factorization can outgrow the
   // workspace the analysis estimated (INFOG(1) = -8 or -9), now and then. MUMPS's remedy is a
@@ -112,6 +150,15 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, i
   // failed, so the whole factorization is redone with a fresh factor.
   retries = 0;
   PetscInt icntl14 = 0; // 0: MUMPS's default
+  PetscInt N = 0;
+  err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
+  const int icntl7 = mumps_icntl7(ordering);
+  std::vector<int> perm_in;
+  double t0 = MPI_Wtime();
+  if (icntl7 == 1)
+    perm_in = metis_pivot_order(K, schur ? std::span<const PetscInt>(*schur)
+                                         : std::span<const PetscInt>());
+  out.ordering_s = MPI_Wtime() - t0;
   for (;;)
   {
     OwnedMat F;
@@ -133,6 +180,19 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, i
     err.check(MatFactorInfoInitialize(&info), "MatFactorInfoInitialize");
     err.check(MatCholeskyFactorSymbolic(F.m, K, nullptr, &info), "MatCholeskyFactorSymbolic");
     check_mumps(err, F.m, "analysis");
+    if (icntl7 != 7)
+    {
+      // PETSc's analysis used MUMPS's automatic choice (PETSc cannot pass ICNTL(7) = 1 and
+      // resets ICNTL(7) before it): redo it with the requested ordering.
+      double t1 = MPI_Wtime();
+      reanalyse(F.m, N, icntl7, perm_in);
+      out.ordering_s += MPI_Wtime() - t1;
+    }
+    if (analysis_only)
+    {
+      analysis_estimates(err, F.m, out);
+      return F.release();
+    }
     err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
     err.check(MatCholeskyFactorNumeric(F.m, K, &info), "MatCholeskyFactorNumeric");
     PetscInt infog1 = 0; // global: every rank takes the same branch
@@ -145,7 +205,8 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur, i
       continue;
     }
     check_mumps(err, F.m, "factorization");
-    null_pivots = check_null_pivots(err, F.m);
+    out.null_pivots = check_null_pivots(err, F.m);
+    factor_statistics(err, F.m, out);
     return F.release();
   }
 }
@@ -367,11 +428,14 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
 } // namespace
 
 Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
-                                     const std::string& method)
+                                     const std::string& method, const std::string& ordering)
 {
   if (method != "schur" and method != "inverse_entries" and method != "matmatsolve")
     throw std::invalid_argument("unknown flexibility method '" + method
                                 + "' (expected 'schur', 'inverse_entries' or 'matmatsolve')");
+  if (!is_ordering(ordering))
+    throw std::invalid_argument("unknown ordering '" + ordering
+                                + "' (expected 'auto', 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
   if (!K)
     throw std::invalid_argument("the stiffness matrix is a null Mat");
 
@@ -414,13 +478,16 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
 
   Flexibility out;
   out.method = used;
+  // A given ordering is set by redoing MUMPS's analysis on rank 0's instance (ordering.h);
+  // on several ranks MUMPS's automatic choice stays.
+  out.ordering = size > 1 ? "mumps" : resolve_ordering(ordering, K);
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
 
   if (n_c == 0)
   {
     double t0 = MPI_Wtime();
-    out.factor = factorize(err, K, nullptr, out.null_pivots, out.factorization_retries);
+    out.factor = factorize(err, K, nullptr, out.ordering, out);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     out.F.resize(0, 0);
@@ -431,7 +498,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     std::vector<PetscInt> root_dofs = rank == 0 ? dofs : std::vector<PetscInt>();
     double t0 = MPI_Wtime();
     OwnedMat F;
-    F.m = factorize(err, K, &root_dofs, out.null_pivots, out.factorization_retries);
+    F.m = factorize(err, K, &root_dofs, out.ordering, out);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     out.F = inverse_of_schur(err, comm, rank, F.m, n_c, out.schur_s, out.inverse_s);
@@ -441,7 +508,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   {
     double t0 = MPI_Wtime();
     OwnedMat F;
-    F.m = factorize(err, K, nullptr, out.null_pivots, out.factorization_retries);
+    F.m = factorize(err, K, nullptr, out.ordering, out);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     double t1 = MPI_Wtime();
@@ -456,5 +523,35 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   out.factorization_s = t[0];
   out.schur_s = t[1];
   out.inverse_s = t[2];
+  return out;
+}
+
+Flexibility flexcontact::factor_analysis(Mat K, std::span<const std::int64_t> contact_dofs,
+                                         const std::string& ordering)
+{
+  if (!is_ordering(ordering))
+    throw std::invalid_argument("unknown ordering '" + ordering
+                                + "' (expected 'auto', 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
+  PetscErrorScope err;
+  MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  if (size > 1)
+    throw std::invalid_argument("factor_analysis runs on one process only");
+  PetscInt N = 0;
+  err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
+  std::vector<PetscInt> dofs(contact_dofs.begin(), contact_dofs.end());
+  for (PetscInt d : dofs)
+    if (d < 0 or d >= N)
+      throw std::invalid_argument("contact DOF out of range [0, " + std::to_string(N)
+                                  + "): " + std::to_string(d));
+  err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
+  Flexibility out;
+  out.ordering = resolve_ordering(ordering, K);
+  out.n_contact_dofs = static_cast<int>(dofs.size());
+  double t0 = MPI_Wtime();
+  OwnedMat F;
+  F.m = factorize(err, K, dofs.empty() ? nullptr : &dofs, out.ordering, out, true);
+  out.factorization_s = MPI_Wtime() - t0;
   return out;
 }

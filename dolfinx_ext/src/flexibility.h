@@ -51,6 +51,13 @@ struct Flexibility
   double schur_s = 0;            ///< extracting K*_cc (schur), the selected-inverse solve
                                  ///< (inverse_entries) or the multi-RHS solve (matmatsolve)
   double inverse_s = 0;          ///< dense Cholesky inversion of K*_cc (schur only)
+  std::string ordering;          ///< ordering requested of MUMPS, "auto" resolved ("mumps" on
+                                 ///< several ranks)
+  std::string mumps_ordering;    ///< ordering MUMPS used, from INFOG(7) ("metis" for ours)
+  double ordering_s = 0;         ///< METIS and the redone analysis (within factorization_s)
+  std::int64_t factor_entries = 0; ///< entries in the factor, INFOG(29)
+  double factor_flops = 0;       ///< flops of the elimination, RINFOG(3)
+  int factor_memory_mb = 0;      ///< MUMPS memory of the factorization (all ranks), INFOG(22)
 };
 
 /// @brief Compute the flexibility on the contact DOFs from a MUMPS Cholesky factorization.
@@ -76,9 +83,21 @@ struct Flexibility
 /// @param K assembled stiffness (MATAIJ family)
 /// @param contact_dofs global row indices of the contact DOFs, on rank 0 (ignored elsewhere)
 /// @param method "schur", "inverse_entries" or "matmatsolve"
+/// @param ordering fill-reducing ordering (ordering.h): "auto" ("metis" for 3D elasticity,
+///   "mumps" otherwise), "metis" (nested dissection of the nodal graph, the Schur variables
+///   last), "mumps" (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd"; on several
+///   ranks MUMPS's automatic choice is used
 /// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
 /// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)
 /// @throws MumpsError on a MUMPS failure, PetscError on a PETSc failure
 Flexibility flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
-                        const std::string& method = "schur");
+                        const std::string& method = "schur",
+                        const std::string& ordering = "auto");
+
+/// @brief MUMPS's analysis only (serial): what the factorization of K with `ordering` and a
+/// Schur complement on `contact_dofs` (none if empty) would cost, without factorizing. In the
+/// returned value factor_entries is INFOG(20), factor_flops RINFOG(1), factor_memory_mb
+/// INFOG(17) (MUMPS's estimates), factorization_s the analysis time; F and factor are empty.
+Flexibility factor_analysis(Mat K, std::span<const std::int64_t> contact_dofs,
+                            const std::string& ordering);
 } // namespace flexcontact

@@ -17,7 +17,8 @@ from . import _cpp  # noqa: F401  (the compiled kernel and PETSc/MUMPS bridge)
 from ._cpp import (ConvergenceError, MumpsError, PetscError, SingularStiffnessError,
                    SolverOptions)
 from .boundary import dirichlet, hold_body
-from .names import FLEXIBILITY_METHODS, SOLVER_NAMES, FlexibilityMethod, SolverName
+from .names import FLEXIBILITY_METHODS, ORDERINGS, SOLVER_NAMES, FlexibilityMethod, Ordering, \
+    SolverName
 from .output import ResultWriter, results_folder, write_summary
 from .problem import (ContactInterface, ContactProblem, ContactZoneError, ContactZoneWarning,
                       IncrementSummary)
@@ -31,7 +32,8 @@ __all__ = [
     "ImpactProblem", "ImpactStepRecord",
     "RigidTarget", "ContactZoneWarning", "ContactZoneError",
     "dirichlet", "hold_body", "ResultWriter", "results_folder", "write_summary",
-    "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES",
+    "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES", "Ordering",
+    "ORDERINGS",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",
     "__version__",
 ]

@@ -37,6 +37,7 @@ class Condensation:
     dim : 2 or 3.
     options : kernel SolverOptions.
     method : how F* is computed (see ``_cpp.flexibility``).
+    ordering : the fill-reducing ordering of the factorization (names.Ordering).
     kernel : optional callable ``(dim, F, X, pairs, mu, constrained, options)`` building
         the kernel object instead of ``_cpp.CondensedContact`` (the impact step builds an
         ``_cpp.ImpactContact`` from the F̂ of its iteration matrix this way).
@@ -47,7 +48,7 @@ class Condensation:
 
     def __init__(self, K: PETSc.Mat, bcs: Sequence, pairs: Optional[NodePairs],
                  mu: np.ndarray, dim: int, comm, options, method: str,
-                 kernel: Optional[Callable] = None):
+                 kernel: Optional[Callable] = None, ordering: str = "auto"):
         self.comm = comm
         root = comm.rank == 0
         self.pairs = pairs
@@ -65,7 +66,7 @@ class Condensation:
 
         self.timings = {}
         t0 = time.perf_counter()
-        F, self.factor, info = _cpp.flexibility(K, self.dofs, method)
+        F, self.factor, info = _cpp.flexibility(K, self.dofs, method, ordering)
         self.timings["flexibility_s"] = time.perf_counter() - t0
         self.flex_info = dict(info)
         self.factorizations = 1

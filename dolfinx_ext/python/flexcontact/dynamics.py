@@ -31,7 +31,7 @@ from . import _cpp, impact_setup as setup
 from ._cpp import ConvergenceError, SolverOptions
 from .condensation import Condensation
 from .energy import EnergyAccount
-from .names import check_chain, check_flexibility_method
+from .names import check_chain, check_flexibility_method, check_ordering
 from .pairing import pair_interfaces
 from .postprocess import ContactFields
 
@@ -89,7 +89,7 @@ class ImpactProblem:
     loads : UFL linear form of constant external loads, or None.
     initial_displacement : a Function on V (m) to start from, e.g. a static state under
         ``loads`` (zeroed at held DOFs); None: zero. Its strain energy is the initial one.
-    solver, flexibility : as for ContactProblem.
+    solver, flexibility, ordering : as for ContactProblem.
 
     Node–surface pairs are re-made before every step but the first (``repair``: B, x0 and
     W_eff from the stored F̂, no factorization; ``pairings`` counts them), unless
@@ -108,11 +108,13 @@ class ImpactProblem:
                  theta: float = 0.5, mass: str = "consistent",
                  rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
                  solver: Optional[SolverOptions] = None, flexibility: str = "schur",
-                 expected_contact_s: Optional[float] = None, initial_displacement=None,
-                 repair_pairs: bool = True):
+                 ordering: str = "auto", expected_contact_s: Optional[float] = None,
+                 initial_displacement=None, repair_pairs: bool = True):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)
+        check_ordering(ordering)
+        self.ordering = ordering
         if solver is not None:
             check_chain(solver.chain)
         self.V, self.msh = V, V.mesh
@@ -186,7 +188,8 @@ class ImpactProblem:
             return _cpp.ImpactContact(dim, F, X, kpairs, mu, e, dt, th, constrained, options)
 
         self.condensation = Condensation(self.W_hat, self.bcs, self.pairs, self.mu, self.dim,
-                                         self.comm, self.options, flexibility, kernel=kernel)
+                                         self.comm, self.options, flexibility, kernel=kernel,
+                                         ordering=self.ordering)
         c = self.condensation
         self.factor, self.flex_info = c.factor, c.flex_info
         self.factorizations = 1
@@ -216,7 +219,7 @@ class ImpactProblem:
         W_hat = setup.iteration_matrix(self.K, self.M, float(dt_s), self.theta, self.rayleigh,
                                        self.marker)
         F, factor, info = _cpp.flexibility(W_hat, self.condensation.dofs,
-                                           self.flexibility_method)
+                                           self.flexibility_method, self.ordering)
         error = None
         if self.comm.rank == 0:
             try:

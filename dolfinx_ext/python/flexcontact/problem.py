@@ -23,7 +23,8 @@ from ._cpp import ConvergenceError, SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
 from .mpi import raise_on_every_rank
-from .names import FlexibilityMethod, check_chain, check_flexibility_method
+from .names import FlexibilityMethod, Ordering, check_chain, check_flexibility_method, \
+    check_ordering
 from .pairing import PAIRINGS, pair_interfaces
 from .postprocess import (STATE_NAMES, ContactFields, IncrementResult,  # noqa: F401
                           IncrementSummary, record_increment)
@@ -144,6 +145,10 @@ class ContactProblem:
         that factor, so MUMPS selected inverse entries are used: "inverse_entries"),
         "inverse_entries", or "matmatsolve" (a multi-right-hand-side solve, the reference).
         Each makes one sparse factorization, which then serves every solve.
+    ordering : fill-reducing ordering of that factorization: "auto" (default: "metis" in
+        3D, "mumps" in 2D), "metis" (METIS nested dissection handed to MUMPS), "mumps"
+        (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd" (names.Ordering;
+        bench/ordering.py compares them).
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
@@ -156,8 +161,9 @@ class ContactProblem:
                  contact: Union[ContactInterface, Sequence[ContactInterface]], *,
                  bodies: Optional[tuple[MeshTags, dict[str, int]]] = None,
                  stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
-                 flexibility: FlexibilityMethod = "schur"):
+                 flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto"):
         check_flexibility_method(flexibility)
+        check_ordering(ordering)
         if solver is not None:
             check_chain(solver.chain)
         self.interfaces = list(contact) if isinstance(contact, (list, tuple)) else [contact]
@@ -173,6 +179,7 @@ class ContactProblem:
         self.stress = stress
         self.options = solver if solver is not None else SolverOptions()
         self.flexibility_method = flexibility
+        self.ordering = ordering
         self.timings = {}
         self.increments: list[IncrementResult] = []
         self.local_problem = None  # rank 0: the last increment's {dim, W, q, mu}
@@ -190,7 +197,8 @@ class ContactProblem:
         self.repairing = any(i.rigid or i.pairing != "node_to_node" for i in self.interfaces)
         self.pairings = 1
         self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
-                                         self.comm, self.options, self.flexibility_method)
+                                         self.comm, self.options, self.flexibility_method,
+                                         ordering=self.ordering)
         c = self.condensation
         self.factorizations = c.factorizations
         self.timings.update(c.timings)

@@ -1,0 +1,186 @@
+// Copyright flexcontact developers. MIT licence.
+
+#include "ordering.h"
+#include "petsc_error.h"
+
+#include <dmumps_c.h>
+#include <metis.h>
+#include <petsc/private/matimpl.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
+
+using namespace flexcontact;
+
+namespace
+{
+constexpr std::array<std::pair<const char*, int>, 6> kOrderings{
+    {{"metis", 1}, {"mumps", 7}, {"amd", 0}, {"amf", 2}, {"pord", 4}, {"qamd", 6}}};
+
+/// @brief Owns one METIS/MUMPS-sized integer buffer from PetscMalloc (PETSc frees PERM_IN
+/// with PetscFree when the factor is destroyed).
+int* petsc_ints(std::size_t n)
+{
+  int* p = nullptr;
+  if (PetscMalloc1(n, &p) != 0 or (n > 0 and !p))
+    throw std::bad_alloc();
+  return p;
+}
+
+/// @brief The compressed nodal graph of K (rows grouped by the block size bs, no self
+/// loops): METIS's xadj and adjncy.
+void nodal_graph(Mat K, PetscInt bs, std::vector<idx_t>& xadj, std::vector<idx_t>& adj)
+{
+  PetscErrorScope err;
+  PetscInt nrows = 0;
+  const PetscInt *ia = nullptr, *ja = nullptr;
+  PetscBool done = PETSC_FALSE;
+  err.check(MatGetRowIJ(K, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done), "MatGetRowIJ");
+  if (!done)
+    throw std::runtime_error("METIS ordering: PETSc cannot give the sparsity pattern of K");
+  const PetscInt n = nrows / bs;
+  xadj.assign(n + 1, 0);
+  adj.clear();
+  adj.reserve(static_cast<std::size_t>(ia[nrows]) / (bs * bs) + n);
+  std::vector<PetscInt> mark(n, -1);
+  for (PetscInt v = 0; v < n; ++v)
+  {
+    xadj[v] = static_cast<idx_t>(adj.size());
+    for (PetscInt r = v * bs; r < (v + 1) * bs; ++r)
+      for (PetscInt k = ia[r]; k < ia[r + 1]; ++k)
+      {
+        const PetscInt w = ja[k] / bs;
+        if (w != v and mark[w] != v)
+        {
+          mark[w] = v;
+          adj.push_back(static_cast<idx_t>(w));
+        }
+      }
+  }
+  xadj[n] = static_cast<idx_t>(adj.size());
+  err.check(MatRestoreRowIJ(K, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done),
+            "MatRestoreRowIJ");
+}
+} // namespace
+
+bool flexcontact::is_ordering(const std::string& name)
+{
+  return name == "auto" or std::any_of(kOrderings.begin(), kOrderings.end(),
+                     [&name](const auto& o) { return name == o.first; });
+}
+
+std::string flexcontact::resolve_ordering(const std::string& name, Mat K)
+{
+  if (name != "auto")
+    return name;
+  PetscInt bs = 1;
+  PetscErrorScope err;
+  err.check(MatGetBlockSize(K, &bs), "MatGetBlockSize");
+  return bs == 3 ? "metis" : "mumps";
+}
+
+int flexcontact::mumps_icntl7(const std::string& name)
+{
+  for (const auto& [n, v] : kOrderings)
+    if (name == n)
+      return v;
+  throw std::invalid_argument("unknown ordering '" + name
+                              + "' (expected 'auto', 'metis', 'mumps', 'amd', 'amf', 'pord' or 'qamd')");
+}
+
+std::string flexcontact::ordering_name(int infog7)
+{
+  switch (infog7)
+  {
+  case 0: return "amd";
+  case 1: return "metis";
+  case 2: return "amf";
+  case 3: return "scotch";
+  case 4: return "pord";
+  case 5: return "mumps_metis";
+  case 6: return "qamd";
+  default: return "unknown(" + std::to_string(infog7) + ")";
+  }
+}
+
+std::vector<int> flexcontact::metis_pivot_order(Mat K, std::span<const PetscInt> last)
+{
+  PetscErrorScope err;
+  PetscInt N = 0, bs = 1;
+  err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
+  err.check(MatGetBlockSize(K, &bs), "MatGetBlockSize");
+  if (bs < 1 or N % bs != 0)
+    bs = 1;
+  std::vector<idx_t> xadj, adj;
+  nodal_graph(K, bs, xadj, adj);
+  idx_t n = static_cast<idx_t>(N / bs);
+  std::vector<idx_t> perm(n), iperm(n);
+  std::array<idx_t, METIS_NOPTIONS> options;
+  METIS_SetDefaultOptions(options.data());
+  int rc = METIS_OK;
+  if (n > 0)
+    rc = METIS_NodeND(&n, xadj.data(), adj.data(), nullptr, options.data(), perm.data(),
+                      iperm.data());
+  if (rc != METIS_OK)
+    throw std::runtime_error("METIS_NodeND failed (return code " + std::to_string(rc)
+                             + ") on the nodal graph of K (" + std::to_string(n) + " nodes)");
+
+  // Pivot position of each row: its node's place in METIS's order, the node's rows kept
+  // together; then the `last` rows moved to the end and the others closed up.
+  std::vector<PetscInt> order(N); // order[position] = row
+  for (idx_t v = 0; v < n; ++v)
+    for (PetscInt c = 0; c < bs; ++c)
+      order[static_cast<std::size_t>(iperm[v]) * bs + c] = static_cast<PetscInt>(v) * bs + c;
+  std::vector<char> is_last(N, 0);
+  for (PetscInt r : last)
+    is_last[r] = 1;
+  std::vector<int> perm_in(N);
+  int pos = 0;
+  for (PetscInt r : order)
+    if (!is_last[r])
+      perm_in[r] = ++pos;
+  for (PetscInt r : last)
+    perm_in[r] = ++pos;
+  return perm_in;
+}
+
+void flexcontact::reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm_in)
+{
+  // PETSc keeps MUMPS's structure first in the factor's data (Mat_MUMPS::id); these are the
+  // values its analysis of a symmetric matrix on one process must have left there.
+  auto* id = static_cast<DMUMPS_STRUC_C*>(F->data);
+  PetscInt infog7 = -1;
+  PetscErrorScope err;
+  err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
+  if (!id or id->job != 1 or id->n != N or id->sym != 2 or id->par != 1
+      or id->infog[0] < 0 or id->infog[6] != infog7)
+    throw std::runtime_error(
+        "cannot give MUMPS an ordering through this PETSc (its MUMPS factor is not laid out "
+        "as expected); use ordering='mumps'");
+  if (icntl7 == 1)
+  {
+    if (perm_in.size() != static_cast<std::size_t>(N))
+      throw std::invalid_argument("PERM_IN has the wrong size");
+    int* p = petsc_ints(perm_in.size());
+    std::memcpy(p, perm_in.data(), perm_in.size() * sizeof(int));
+    PetscFree(id->perm_in); // the factor owns PERM_IN; none is set unless redone here
+    id->perm_in = p;
+  }
+  id->icntl[6] = icntl7;
+  id->job = 1;
+  dmumps_c(id);
+  if (id->infog[0] < 0)
+    throw std::runtime_error("MUMPS failed in the analysis with ordering ICNTL(7)="
+                             + std::to_string(icntl7) + ": INFOG(1)="
+                             + std::to_string(id->infog[0]) + ", INFOG(2)="
+                             + std::to_string(id->infog[1]));
+  // MUMPS may replace one of its own orderings (with a Schur complement AMF, PORD, QAMD become
+  // AMD, INFOG(7) says), but must follow a given permutation.
+  if (icntl7 == 1 and id->infog[6] != 1)
+    throw std::runtime_error("MUMPS did not use the requested ordering ICNTL(7)="
+                             + std::to_string(icntl7) + " (INFOG(7)="
+                             + std::to_string(id->infog[6]) + ")");
+}
