@@ -135,7 +135,7 @@ def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> str:
             "pairing='node_to_surface' for non-matching meshes")
 
 
-PAIRINGS = ("node_to_node", "node_to_surface")
+PAIRINGS = ("node_to_node", "node_to_surface", "surface_to_surface")
 
 
 def pair_interfaces(V, interfaces: Sequence, comm):
