@@ -42,8 +42,9 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         matching: True: the interface meshes are identical copies, node for node (above);
             False: non-matching interface meshes — in 2D the upper body's interface gets
             NONMATCHING_RATIO times as many segments, graded the other way (no interior node
-            of one side faces a node of the other), in 3D the two faces are meshed
-            independently with interface sizes h_i and NONMATCHING_RATIO·h_i.
+            of one side faces a node of the other), in 3D the upper body's interface face is
+            structured (transfinite) with NONMATCHING_RATIO times as many segments per edge
+            as the lower face's unstructured mesh of size h_i.
 
     ``info``: dim, width, lower_height, upper_height, h_lower, h_upper, h_interface (the
     interface size asked of gmsh; in 2D the mean segment length), area (the interface
@@ -138,6 +139,15 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         if matching:
             identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
             gmsh.model.mesh.setPeriodic(2, slave, master, identity)
+        else:
+            # The slave face structured (transfinite, NONMATCHING_RATIO times finer along
+            # each edge), the master face unstructured: no node of one faces one of the other
+            # except at the corners.
+            n_up = max(2, round(NONMATCHING_RATIO * math.ceil(w / hi - 1e-9)))
+            for f in slave:
+                for _, c in gmsh.model.getBoundary([(2, f)], oriented=False):
+                    gmsh.model.mesh.setTransfiniteCurve(abs(c), n_up + 1)
+                gmsh.model.mesh.setTransfiniteSurface(f)
 
         _gmsh.physical(3, lower_vol, BASE, NAMES[BASE])
         _gmsh.physical(3, upper_vol, UPPER, NAMES[UPPER])

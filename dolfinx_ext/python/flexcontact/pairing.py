@@ -83,7 +83,7 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
         raise NonMatchingError(
             f"node–node contact{where}: the slave surface has {ns} nodes and the master "
             f"surface {nm}; node–node pairing needs matching interface nodes; use "
-            f"pairing='surface_to_surface' (2D) or 'node_to_surface' for non-matching meshes")
+            f"pairing='surface_to_surface' or 'node_to_surface' for non-matching meshes")
     if ns == 0:
         raise ValueError(f"node–node contact{where}: the contact surfaces have no nodes")
     normals = np.asarray(master["normal"])
@@ -136,16 +136,15 @@ def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> tuple[str
     if facing:
         return (head + "; the two surfaces' nodes do face each other one to one, but along "
                 "the slave's normals, not the master's, as on a curved master surface. Use "
-                "pairing='node_to_surface' or 'surface_to_surface' (2D; any choice of slave "
-                "and master), or make the flat surface the master"), True
+                "pairing='node_to_surface' or 'surface_to_surface' (any choice of slave and "
+                "master), or make the flat surface the master"), True
     return (head + "; the contact surfaces have no matching nodes. Use "
-            "pairing='surface_to_surface' (2D) or 'node_to_surface' for non-matching "
+            "pairing='surface_to_surface' or 'node_to_surface' for non-matching "
             "meshes"), False
 
 
 # "auto": node–node where the surfaces' nodes match, surface–surface (the pairing that passes
-# the patch test on non-matching meshes) where they do not; in 3D, where surface–surface is
-# not available yet, a non-matching interface is an error that names the pairings to choose.
+# the patch test on non-matching meshes) where they do not.
 PAIRINGS = ("auto", "node_to_node", "node_to_surface", "surface_to_surface")
 
 
@@ -206,13 +205,11 @@ def _candidate_surface(V, facet_tags, value: int) -> dict:
 def _resolve(kind: str, s: dict, m, itf, dim: int):
     """The pairing of one interface and what build_surface_pairs needs of the master:
     NodePairs for node–node, the master surface (or the rigid target) otherwise. "auto" is
-    node–node where the nodes match, else surface–surface in 2D (rank 0)."""
+    node–node where the nodes match, else surface–surface (rank 0)."""
     if kind == "auto":
         try:
             return "node_to_node", _node_pairs(s, m, itf)
         except NonMatchingError:
-            if dim != 2:
-                raise
             return "surface_to_surface", m
     if kind == "node_to_node":
         return kind, _node_pairs(s, m, itf)

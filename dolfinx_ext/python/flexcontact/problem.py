@@ -62,7 +62,7 @@ class ContactInterface:
 
     * "auto" (default): "node_to_node" when the two surfaces' nodes match one to one, else
       "surface_to_surface" (the pairing that passes the contact patch test on non-matching
-      meshes; 2D; in 3D a non-matching interface raises, naming the pairings to choose).
+      meshes).
       ``pairing_used`` tells, once the problem is built, which one was taken.
     * "node_to_node": each slave node with the master node on its master normal
       line. Needs matching interface nodes, and master normals along the lines joining
@@ -71,9 +71,10 @@ class ContactInterface:
       (non-matching meshes, curved surfaces, either body as slave); pairs are re-made before
       every increment from the current positions, with the F* computed once on all nodes
       of both tagged surfaces (so tag them generously: the candidate zone).
-    * "surface_to_surface" (2D): integrated, mortar-type rows (mortar.py): one row per slave
-      node, its weak gap with the dual multiplier basis integrated exactly over the segment
-      overlaps, along the slave node's normal. Uniform pressure is transmitted exactly
+    * "surface_to_surface": integrated, mortar-type rows (mortar.py): one row per slave
+      node, its weak gap with the dual multiplier basis integrated exactly over the overlaps
+      (segment intersection in 2D, triangles clipped in 3D; 3D quadrilateral facets are not
+      supported yet), along the slave node's normal. Uniform pressure is transmitted exactly
       across non-matching meshes (the patch test); re-made before every increment like
       node–surface pairs.
 

@@ -21,8 +21,9 @@ from typing import Optional
 
 import numpy as np
 
-from .mortar import mortar_rows_2d
-from .projection import (boundary_nodes, closest_points, facet_normals, nodal_normals)
+from .mortar import mortar_rows_2d, mortar_rows_3d
+from .projection import (boundary_nodes, closest_points, facet_measures, facet_normals,
+                         nodal_normals)
 
 
 @dataclass
@@ -139,7 +140,8 @@ class NodeToSurfacePairer:
 
 @dataclass
 class SurfaceToSurfacePairer:
-    """Mortar rows of the slave nodes with the dual basis (mortar.py), 2D: slave node j with
+    """Mortar rows of the slave nodes with the dual basis (mortar.py; 2D segments, 3D
+    triangles): slave node j with
     weight 1, master nodes k with weights M_jk / D_jj, along the slave node's normal
     (pointing towards the slave body, as the master's outward normal does). A slave node
     that the master surface does not cover at all gets its closest-point row instead (the
@@ -161,8 +163,9 @@ class SurfaceToSurfacePairer:
         mnodes = np.unique(fb.facets)
         local_m = np.searchsorted(mnodes, fb.facets)
         Xs, Xm = xcur[snodes], xcur[mnodes]
-        D, rows, cols, vals = mortar_rows_2d(Xs, local_s, self.slave_normal, Xm, local_m,
-                                             fb.facet_normal, self.cutoff_m)
+        rows_of = mortar_rows_2d if xcur.shape[1] == 2 else mortar_rows_3d
+        D, rows, cols, vals = rows_of(Xs, local_s, self.slave_normal, Xm, local_m,
+                                      fb.facet_normal, self.cutoff_m)
         full = self._full_measure(Xs, local_s)
         covered = D > 1e-12 * np.maximum(full, 1e-300)
         keep = covered[rows] & (vals != 0.0)
@@ -200,9 +203,9 @@ class SurfaceToSurfacePairer:
     @staticmethod
     def _full_measure(X, facets):
         """∫ N_j over the whole slave surface: the lumped tributary measure of each node."""
-        L = np.linalg.norm(X[facets[:, 1]] - X[facets[:, 0]], axis=1)
+        nv = facets.shape[1]
         out = np.zeros(X.shape[0])
-        np.add.at(out, facets.reshape(-1), np.repeat(0.5 * L, 2))
+        np.add.at(out, facets.reshape(-1), np.repeat(facet_measures(X, facets) / nv, nv))
         return out
 
 
@@ -311,9 +314,6 @@ def _mortar_pairer(fallback: NodeToSurfacePairer, slave: dict, master: dict, fir
     """The surface–surface pairer of one interface; its overlaps count up to half the
     diagonal of the two candidate surfaces' bounding box away from the slave surface (the
     facing test already excludes the far side of a closed surface)."""
-    if dim != 2:
-        raise ValueError("pairing='surface_to_surface' is implemented in 2D only; use "
-                         "pairing='node_to_surface' in 3D")
     pts = np.vstack([np.asarray(slave["x"]), np.asarray(master["x"])])
     cutoff = 0.5 * float(np.linalg.norm(np.ptp(pts, axis=0)))
     return SurfaceToSurfacePairer(
