@@ -42,6 +42,7 @@ def test_hertz_surface_to_surface_either_slave(hertz):
     assert s["factorizations"] == 1
     assert s["pairings"] == len(s["increments"]) + 1
     assert s["max_penetration_rel"] < 1e-6
+    assert all(not inc["zone_edge"] for inc in s["increments"])
 
 
 @pytest.mark.mpi

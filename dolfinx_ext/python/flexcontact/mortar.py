@@ -205,11 +205,17 @@ def mortar_rows_3d(Xs, slave_facets, slave_ref, Xm, master_facets, master_ref, c
     nm /= np.linalg.norm(nm, axis=1)[:, None]
     nm[np.einsum("fk,fk->f", nm, master_ref) < 0] *= -1
     # Candidate couples: facing, and bounding boxes (grown by the cutoff) that meet.
-    lo_s, hi_s = S.min(axis=1), S.max(axis=1)
+    lo_s, hi_s = S.min(axis=1) - cutoff_m, S.max(axis=1) + cutoff_m
     lo_m, hi_m = Mt.min(axis=1), Mt.max(axis=1)
-    meet = np.all((lo_m[None] <= hi_s[:, None] + cutoff_m)
-                  & (hi_m[None] >= lo_s[:, None] - cutoff_m), axis=2)
-    s_idx, k_idx = np.nonzero(meet & ((ns @ nm.T) < 0.0))
+    s_idx, k_idx = [], []
+    chunk = max(1, 4_000_000 // max(Mt.shape[0], 1))   # slave facets per batch
+    for a in range(0, S.shape[0], chunk):
+        b = min(a + chunk, S.shape[0])
+        meet = np.all((lo_m[None] <= hi_s[a:b, None]) & (hi_m[None] >= lo_s[a:b, None]), axis=2)
+        si, ki = np.nonzero(meet & ((ns[a:b] @ nm.T) < 0.0))
+        s_idx.append(si + a)
+        k_idx.append(ki)
+    s_idx, k_idx = np.concatenate(s_idx), np.concatenate(k_idx)
     nfs = slave_facets.shape[0]
     Me = np.zeros((nfs, 3, 3))
     couples = []
