@@ -1,4 +1,5 @@
-"""Surface–surface (mortar) weights of 2D contact rows, integrated exactly over the overlaps.
+"""Surface–surface (mortar) weights of contact rows, integrated exactly over the overlaps:
+segments intersected in 2D, triangles clipped against each other in 3D (mortar_rows_3d).
 
 One contact row per slave node j: the weak gap g_j = Σ_i D_ji x_i − Σ_k M_jk x̂_k along the
 slave node's normal, with D_ji = ∫ ψ_j N_i and M_jk = ∫ ψ_j N̂_k over the parts of the slave
@@ -6,7 +7,8 @@ surface that the master surface covers. ψ_j is the *dual* Lagrange multiplier b
 (Wohlmuth): biorthogonal to the slave shape functions, ∫ ψ_j N_i = δ_ji D_jj, so D is
 diagonal and row j, divided by D_jj, is a node-like row: slave node j with weight 1 and the
 master nodes k with weights M_jk / D_jj. The multiplier of that row is then the nodal
-force of slave node j [N/m in 2D] and its gap is in metres, as for node–node pairs.
+force of slave node j [N/m in 2D, N in 3D] and its gap is in metres, as for node–node
+pairs.
 
 Segmentation (2D). A master segment is projected on the line of a slave segment along the
 slave segment's normal; the overlap is an interval [ξ0, ξ1] of the slave parameter ξ ∈ [0, 1].
