@@ -177,7 +177,8 @@ def pair_interfaces(V, interfaces: Sequence, comm):
                 error = str(e)
     if root and error is None and any(k != "node_to_node" for k, _, _ in parts):
         try:
-            pairs = build_surface_pairs(parts, V.mesh.geometry.dim)
+            pairs = build_surface_pairs(parts, V.mesh.geometry.dim,
+                                        [itf.label for itf in interfaces])
         except ValueError as e:
             error = str(e)
     elif root and error is None:

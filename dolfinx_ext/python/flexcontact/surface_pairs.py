@@ -154,6 +154,7 @@ class SurfaceToSurfacePairer:
     fallback: NodeToSurfacePairer
     cutoff_m: float             # largest slave–master distance of an overlap
     width: int = 4
+    covered: int = 0            # slave nodes with mortar rows at the last pairing
 
     def pair(self, xcur):
         fb = self.fallback
@@ -178,6 +179,7 @@ class SurfaceToSurfacePairer:
         r, c = uniq // mnodes.size, uniq % mnodes.size
         count = np.bincount(r, minlength=snodes.size)
         covered &= count > 0
+        self.covered = int(covered.sum())
         width = max(int(count.max(initial=0)), masters.shape[1])
         self.width = max(self.width, width)
         m_out = np.repeat(masters[:, :1], width, axis=1)
@@ -235,13 +237,17 @@ def slave_edge_flags(slave: dict, dim: int) -> np.ndarray:
     return boundary_nodes(facets, dim, np.asarray(slave["x"]).shape[0])
 
 
-def build_surface_pairs(parts: list, dim: int) -> SurfacePairs:
+def build_surface_pairs(parts: list, dim: int, labels=None) -> SurfacePairs:
     """SurfacePairs of several interfaces from their gathered surfaces (rank 0).
 
     ``parts`` holds one tuple per interface: ("node_to_node", slave, NodePairs),
-    ("node_to_surface", slave, master) or ("rigid", slave, RigidTarget), ``slave`` and
-    ``master`` the dicts of ``surface_nodes``. Pairs are made in the reference
-    configuration (rigid targets at their current displacement).
+    ("node_to_surface" or "surface_to_surface", slave, master) or ("rigid", slave,
+    RigidTarget), ``slave`` and ``master`` the dicts of ``surface_nodes``; ``labels`` name
+    the interfaces in errors. Pairs are made in the reference configuration (rigid targets
+    at their current displacement).
+
+    Raises ValueError when a surface–surface interface has no slave node that a facing
+    master facet covers: the tags name surfaces that do not face each other.
     """
     n_slave = [np.asarray(s["x"]).shape[0] for _, s, _ in parts]
     m = int(sum(n_slave))
@@ -306,6 +312,14 @@ def build_surface_pairs(parts: list, dim: int) -> SurfacePairs:
     if targets:
         u0[n_nodes - len(targets):] = pairs.virtual_displacement().reshape(-1, dim)
     pairs.repair(u0.reshape(-1))
+    for i, p in enumerate(pairers):
+        if isinstance(p, SurfaceToSurfacePairer) and p.covered == 0:
+            label = labels[i] if labels else f"interface {i}"
+            raise ValueError(
+                f"surface–surface contact ({label}): none of the {p.slave_rows.size} slave "
+                "nodes is covered by a master facet facing it (outward normals opposite, "
+                f"within {p.cutoff_m:.3g} m): the slave and master tags name surfaces that "
+                "do not face each other")
     return pairs
 
 
