@@ -133,6 +133,12 @@ def _dual_coefficients(Me, De):
 _MIDPOINTS = np.array([[0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]])
 
 
+def _cross2(a, b):
+    """z component of the cross product of two plane vectors (NumPy 2 deprecates np.cross
+    of 2-vectors)."""
+    return a[0] * b[1] - a[1] * b[0]
+
+
 def _clip(subject, clipper):
     """Sutherland–Hodgman: the part of the convex polygon ``subject`` (k, 2) inside the
     counter-clockwise triangle ``clipper`` (3, 2)."""
@@ -167,7 +173,7 @@ def _couple_3d(Ts, Tm):
     """∫ N_a N_b (3, 3) and ∫ N_a N̂_c (3, 3) over the overlap of the slave triangle Ts and
     the projected master triangle Tm (both (3, 2) in the slave plane, Ts counter-clockwise);
     None when they do not overlap."""
-    if np.cross(Tm[1] - Tm[0], Tm[2] - Tm[0]) < 0:
+    if _cross2(Tm[1] - Tm[0], Tm[2] - Tm[0]) < 0:
         Tm = Tm[::-1].copy()
         flip = True
     else:
@@ -179,7 +185,7 @@ def _couple_3d(Ts, Tm):
     Mss, Msm = np.zeros((3, 3)), np.zeros((3, 3))
     for i in range(len(poly)):
         tri = np.array([c, poly[i], poly[(i + 1) % len(poly)]])
-        area = 0.5 * abs(np.cross(tri[1] - tri[0], tri[2] - tri[0]))
+        area = 0.5 * abs(_cross2(tri[1] - tri[0], tri[2] - tri[0]))
         if area <= 0.0:
             continue
         pts = _MIDPOINTS @ tri
@@ -233,7 +239,7 @@ def mortar_rows_3d(Xs, slave_facets, slave_ref, Xm, master_facets, master_ref, c
             continue
         Ts = np.column_stack([rel_s @ e1, rel_s @ e2])
         Tm = np.column_stack([rel_m @ e1, rel_m @ e2])
-        if abs(np.cross(Tm[1] - Tm[0], Tm[2] - Tm[0])) <= 1e-14 * np.ptp(Ts, axis=0).max()**2:
+        if abs(_cross2(Tm[1] - Tm[0], Tm[2] - Tm[0])) <= 1e-14 * np.ptp(Ts, axis=0).max()**2:
             continue                      # master triangle seen edge-on
         got = _couple_3d(Ts, Tm)
         if got is None:
