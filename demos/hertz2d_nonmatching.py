@@ -3,8 +3,10 @@
 #
 # The set-up of `hertz2d.py` — a steel half-cylinder of radius R pressed onto a steel block
 # by lowering its flat top — with the block's contact zone meshed at a different spacing
-# from the cylinder's, so that no node faces another. Pairs are node–surface: each slave
-# node against its closest point on the master facets, with the facet's shape weights.
+# from the cylinder's, so that no node faces another. Pairs are node–surface by default: each
+# slave node against its closest point on the master facets, with the facet's shape weights;
+# `--pairing surface_to_surface` uses integrated mortar rows (dual basis, exact integration
+# over the segment overlaps, mortar.py) instead.
 # `--slave cylinder` pairs the cylinder's nodes with the flat block; `--slave block` pairs
 # the block's nodes with the faceted arc of the cylinder. Either way Hertz's answer
 # (docs/architecture.md §6) is the reference:
@@ -14,7 +16,8 @@
 # Pairs are re-made before each increment from the current positions; F* was computed
 # once, on all nodes of both tagged zones, and the summary counts the factorizations.
 #
-# Run: `/usr/bin/python3 demos/hertz2d_nonmatching.py [--slave block] [--refine N]`
+# Run: `/usr/bin/python3 demos/hertz2d_nonmatching.py [--slave block] [--refine N]
+# [--pairing surface_to_surface]`
 # (also with `mpirun -n 2`).
 
 # %%
@@ -34,6 +37,8 @@ parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--slave", choices=("cylinder", "block"), default="cylinder",
                     help="the body whose nodes are paired")
 parser.add_argument("--refine", type=int, default=0, help="halve the contact element size N times")
+parser.add_argument("--pairing", choices=("node_to_surface", "surface_to_surface"),
+                    default="node_to_surface", help="ContactInterface.pairing")
 parser.add_argument("--block-spacing", type=float, default=0.7,
                     help="the block's zone spacing relative to the cylinder's")
 parser.add_argument("--increments", type=int, default=4, help="load increments")
@@ -74,7 +79,7 @@ top, (top_x, top_y) = fc.dirichlet(V, facets, tags.LOADED)
 problem = fc.ContactProblem(
     a, None, fixed + top,
     fc.ContactInterface(facets, slave=slave, master=master, mu=0.0,
-                        name=f"hertz, {args.slave} as slave", pairing="node_to_surface"),
+                        name=f"hertz, {args.slave} as slave", pairing=args.pairing),
     bodies=(cells, {"block": tags.BASE, "cylinder": tags.UPPER}))
 
 # %% [markdown]
@@ -99,8 +104,10 @@ def load(i, t):
     top_y.value = -(delta["trial"] + (delta["final"] - delta["trial"]) * (i - 1) / (n - 1))
 
 
-name = f"hertz2d_nonmatching_{args.slave}"
-folder = fc.results_folder(f"hertz2d_nonmatching/{args.slave}")
+# Node–surface results keep their folder; other pairings get their own beside it.
+suffix = "" if args.pairing == "node_to_surface" else f"_{args.pairing}"
+name = f"hertz2d_nonmatching_{args.slave}{suffix}"
+folder = fc.results_folder(f"hertz2d_nonmatching/{args.slave}{suffix}")
 with fc.ResultWriter(folder, name, msh) as out:
     summaries = problem.solve(max(args.increments, 2), load=load, writer=out)
 
@@ -125,7 +132,7 @@ if comm.rank == 0:
     p_ref = np.array([analytic.hertz_pressure(xi, a_ref, p0_ref) for xi in x])
     rms = float(np.sqrt(np.mean((p[inside] - p_ref[inside]) ** 2)) / p0_ref)
     summary = {
-        "demo": "hertz2d_nonmatching", "slave": args.slave, "pairing": "node_to_surface",
+        "demo": "hertz2d_nonmatching", "slave": args.slave, "pairing": args.pairing,
         "units": "SI (m, Pa, N/m)",
         "P": P, "P_target": P_target, "R_m": R, "a_target_m": a_target,
         "materials": {"block": {"E_Pa": steel.E_Pa, "nu": steel.nu},
@@ -143,7 +150,7 @@ if comm.rank == 0:
         "profile": {"x": x, "pressure": p, "state": states},
     }
     fc.write_summary(folder, summary)
-    print(f"Hertz ({args.slave} as slave): a = {a_fit:.5e} m (ref {a_ref:.5e}, "
+    print(f"Hertz ({args.slave} as slave, {args.pairing}): a = {a_fit:.5e} m (ref {a_ref:.5e}, "
           f"{100 * (a_fit / a_ref - 1):+.2f}%), p0 = {p0:.5e} Pa (ref {p0_ref:.5e}, "
           f"{100 * (p0 / p0_ref - 1):+.2f}%); largest nodal pressure "
           f"{100 * (p_nodal_max / p0_ref - 1):+.2f}%, RMS deviation {100 * rms:.1f}% of p0; "

@@ -24,10 +24,11 @@ from . import _check, _gmsh
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y, UPPER
 
 PROGRESSION_2D = 1.15  # ratio of neighbouring interface segments in 2D (any value matches)
+NONMATCHING_RATIO = 1.5  # upper/lower interface segment counts (2D) or sizes (3D), non-matching
 
 
 def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=0.02,
-          h_upper=0.03, refine=0):
+          h_upper=0.03, refine=0, matching=True):
     """Build the patch-test mesh on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -38,6 +39,12 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         h_lower, h_upper: element sizes (m) at the lower body's bottom and the upper body's
             top; the interface gets min(h_lower, h_upper).
         refine: each level halves both sizes.
+        matching: True: the interface meshes are identical copies, node for node (above);
+            False: non-matching interface meshes — in 2D the upper body's interface gets
+            NONMATCHING_RATIO times as many segments, graded the other way (no interior node
+            of one side faces a node of the other), in 3D the upper body's interface face is
+            structured (transfinite) with NONMATCHING_RATIO times as many segments per edge
+            as the lower face's unstructured mesh of size h_i.
 
     ``info``: dim, width, lower_height, upper_height, h_lower, h_upper, h_interface (the
     interface size asked of gmsh; in 2D the mean segment length), area (the interface
@@ -45,6 +52,8 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
     """
     if dim not in (2, 3) or isinstance(dim, bool):
         raise ValueError(f"dim={dim!r}: must be 2 or 3")
+    if not isinstance(matching, bool):
+        raise ValueError(f"matching={matching!r}: must be True or False")
     w = _check.positive("width", width)
     H1 = _check.positive("lower_height", lower_height)
     H2 = _check.positive("upper_height", upper_height)
@@ -86,8 +95,14 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         u_bot, u_right = geo.addLine(q[0], q[1]), geo.addLine(q[1], q[2])
         u_top, u_left = geo.addLine(q[2], q[3]), geo.addLine(q[3], q[0])
         s_upper = geo.addPlaneSurface([geo.addCurveLoop([u_bot, u_right, u_top, u_left])])
-        for c in (top, u_bot):
-            geo.mesh.setTransfiniteCurve(c, n + 1, "Progression", PROGRESSION_2D)
+        if matching:
+            for c in (top, u_bot):
+                geo.mesh.setTransfiniteCurve(c, n + 1, "Progression", PROGRESSION_2D)
+        else:
+            n_up = max(n + 1, round(NONMATCHING_RATIO * n))
+            geo.mesh.setTransfiniteCurve(top, n + 1, "Progression", PROGRESSION_2D)
+            geo.mesh.setTransfiniteCurve(u_bot, n_up + 1, "Progression", 1 / PROGRESSION_2D)
+            info["n_contact_nodes_upper"] = n_up + 1
         geo.synchronize()
 
         _gmsh.physical(2, [s_lower], BASE, NAMES[BASE])
@@ -121,8 +136,18 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         top = _gmsh.faces_in(0, 0, H2, w, w, H2, upper_vol)
         sym_x = _gmsh.faces_in(0, 0, -H1, 0, w, H2, both)
         sym_y = _gmsh.faces_in(0, 0, -H1, w, 0, H2, both)
-        identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
-        gmsh.model.mesh.setPeriodic(2, slave, master, identity)
+        if matching:
+            identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+            gmsh.model.mesh.setPeriodic(2, slave, master, identity)
+        else:
+            # The slave face structured (transfinite, NONMATCHING_RATIO times finer along
+            # each edge), the master face unstructured: no node of one faces one of the other
+            # except at the corners.
+            n_up = max(2, round(NONMATCHING_RATIO * math.ceil(w / hi - 1e-9)))
+            for f in slave:
+                for _, c in gmsh.model.getBoundary([(2, f)], oriented=False):
+                    gmsh.model.mesh.setTransfiniteCurve(abs(c), n_up + 1)
+                gmsh.model.mesh.setTransfiniteSurface(f)
 
         _gmsh.physical(3, lower_vol, BASE, NAMES[BASE])
         _gmsh.physical(3, upper_vol, UPPER, NAMES[UPPER])

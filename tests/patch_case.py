@@ -46,12 +46,17 @@ _STEEL = forms.Material(E_Pa=200e9, nu=0.3, name="steel")
 _ALU = forms.Material(E_Pa=70e9, nu=0.33, name="aluminium")
 
 
+CASES = ("stick", "frictionless", "one_material")
+
+
 def materials(dim, case):
     """(lower, upper, mu) of a case."""
     if case == "frictionless":
         return _STEEL, _ALU, 0.0
+    if case == "one_material":  # both bodies steel, μ = 0: no slip, p only
+        return _STEEL, _STEEL, 0.0
     if case != "stick":
-        raise ValueError(f"case={case!r}: 'stick' or 'frictionless'")
+        raise ValueError(f"case={case!r}: one of {', '.join(CASES)}")
     lower = forms.Material(E_Pa=70e9, nu=0.15, name="lower")
     nu2 = 0.3
     if dim == 3:
@@ -90,15 +95,18 @@ def mesh_sizes(dim):
     return dict(h_lower=0.02, h_upper=0.03) if dim == 3 else dict(h_lower=0.012, h_upper=0.02)
 
 
-def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tolerance=1e-10):
+def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tolerance=1e-10,
+        pairing="node_to_node", matching=True):
     """Solve the case and return its measurements (the same dict on every rank).
 
     ``chain``: the kernel's solvers, in order (SolverOptions.chain; empty: the default chain,
     which starts with projection sweeps); ``tolerance``: SolverOptions.tolerance, the
     relative natural-map residual at which an answer is accepted. The active-set method
     (the seed's) is exact once its states settle, so its answer is exact up to round-off.
+    ``pairing``: the ContactInterface's; ``matching``: False for non-matching interface
+    meshes (meshes/patch.py).
     """
-    msh, cells, facets, geo = patch.build(comm, dim=dim, **mesh_sizes(dim))
+    msh, cells, facets, geo = patch.build(comm, dim=dim, matching=matching, **mesh_sizes(dim))
     H1, H2, A = geo["lower_height"], geo["upper_height"], geo["area"]
     lower, upper, mu = materials(dim, case)
     kind = "3d" if dim == 3 else "plane_strain"
@@ -118,7 +126,8 @@ def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tol
     options.tolerance = tolerance
     problem = fc.ContactProblem(
         a, None, fixed + top + sym,
-        fc.ContactInterface(facets, slave=tags.SLAVE, master=tags.MASTER, mu=mu, name="patch"),
+        fc.ContactInterface(facets, slave=tags.SLAVE, master=tags.MASTER, mu=mu, name="patch",
+                            pairing=pairing),
         bodies=(cells, {"lower": tags.BASE, "upper": tags.UPPER}), solver=options)
 
     def load(i, t):
@@ -175,6 +184,7 @@ def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tol
         order = np.lexsort(xs.T[::-1])
         out = {
             "dim": dim, "case": case, "mu": mu, "ranks": comm.size, "pairs": int(m),
+            "pairing": pairing, "matching": matching,
             "increments": increments, "flexibility": problem.flex_info.get("method"),
             "p_exact_Pa": p, "A": A, "N": s.normal_force, "N_exact": p * A,
             "N_error_rel": abs(s.normal_force / (p * A) - 1),
@@ -207,10 +217,15 @@ def main(argv=None):
                     help="comma-separated solver chain; 'default' for the kernel's default")
     ap.add_argument("--tolerance", type=float, default=1e-10)
     ap.add_argument("--out", type=Path, help="also write the results (a JSON list) here")
+    ap.add_argument("--pairing", default="node_to_node",
+                    help="comma-separated pairings (ContactInterface.pairing)")
+    ap.add_argument("--nonmatching", action="store_true", help="non-matching interface meshes")
     args = ap.parse_args(argv)
     chain = [] if args.chain == "default" else args.chain.split(",")
-    results = [run(int(d), c, increments=args.increments, chain=chain, tolerance=args.tolerance)
-               for d in args.dims.split(",") for c in args.cases.split(",")]
+    results = [run(int(d), c, increments=args.increments, chain=chain, tolerance=args.tolerance,
+                   pairing=pg, matching=not args.nonmatching)
+               for d in args.dims.split(",") for c in args.cases.split(",")
+               for pg in args.pairing.split(",")]
     if MPI.COMM_WORLD.rank == 0:
         if args.out:
             args.out.write_text(json.dumps(results))

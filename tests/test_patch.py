@@ -103,7 +103,8 @@ def test_mesh_rejects_bad_parameters():
     for kwargs, word in [({"dim": 4}, "dim=4"), ({"width": -0.1}, "width=-0.1"),
                          ({"lower_height": 0}, "lower_height=0"),
                          ({"h_upper": float("nan")}, "h_upper=nan"),
-                         ({"refine": 1.5}, "refine=1.5"), ({"dim": True}, "dim=True")]:
+                         ({"refine": 1.5}, "refine=1.5"), ({"dim": True}, "dim=True"),
+                         ({"matching": "no"}, "matching='no'")]:
         with pytest.raises(ValueError, match=word):
             patch.build(COMM, **kwargs)
 

@@ -20,6 +20,11 @@ from .mpi import raise_on_every_rank
 from .zone import open_edge_flags
 
 
+class NonMatchingError(ValueError):
+    """The two contact surfaces have no matching nodes (counts differ, or nodes do not face
+    each other one to one in any direction): a mesh property, not a set-up error."""
+
+
 @dataclass
 class NodePairs:
     """Pairs of one contact interface, in the node-major contact numbering.
@@ -75,9 +80,10 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
     ns, nm = xs.shape[0], xm.shape[0]
     where = f" ({label})" if label else ""
     if ns != nm:
-        raise ValueError(
+        raise NonMatchingError(
             f"node–node contact{where}: the slave surface has {ns} nodes and the master "
-            f"surface {nm}; node–node pairing needs matching interface nodes")
+            f"surface {nm}; node–node pairing needs matching interface nodes; use "
+            f"pairing='surface_to_surface' or 'node_to_surface' for non-matching meshes")
     if ns == 0:
         raise ValueError(f"node–node contact{where}: the contact surfaces have no nodes")
     normals = np.asarray(master["normal"])
@@ -93,12 +99,13 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
         offset[start:start + chunk] = dt[np.arange(best.size), best]
     worst = int(np.argmax(offset))
     if offset[worst] > tolerance:
-        raise ValueError(_unmatched_message(xs, np.asarray(slave["normal"]), xm, offset, worst,
-                                            tolerance, where))
+        text, facing = _unmatched_message(xs, np.asarray(slave["normal"]), xm, offset, worst,
+                                          tolerance, where)
+        raise (ValueError if facing else NonMatchingError)(text)
     taken, counts = np.unique(partner, return_counts=True)
     if np.any(counts > 1):
         dup = int(taken[np.argmax(counts)])
-        raise ValueError(
+        raise NonMatchingError(
             f"node–node contact{where}: {int(counts.max())} slave nodes match the same master "
             f"node at {xm[dup].tolist()}; the surfaces' nodes do not match one to one")
     return NodePairs(
@@ -111,10 +118,10 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
     )
 
 
-def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> str:
-    """Why node–node pairing failed: nodes that face each other one to one along the
-    slave's normals but not along the master's (a curved or tilted master), or nodes that
-    do not match at all."""
+def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> tuple[str, bool]:
+    """Why node–node pairing failed, and whether the nodes face each other one to one along
+    the slave's normals but not along the master's (a curved or tilted master: True) or do
+    not match at all (False)."""
     partner, off = [], []
     for x, n in zip(xs, ns):
         d = xm - x
@@ -129,13 +136,16 @@ def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> str:
     if facing:
         return (head + "; the two surfaces' nodes do face each other one to one, but along "
                 "the slave's normals, not the master's, as on a curved master surface. Use "
-                "pairing='node_to_surface' (any choice of slave and master), or make the "
-                "flat surface the master")
+                "pairing='node_to_surface' or 'surface_to_surface' (any choice of slave and "
+                "master), or make the flat surface the master"), True
     return (head + "; the contact surfaces have no matching nodes. Use "
-            "pairing='node_to_surface' for non-matching meshes")
+            "pairing='surface_to_surface' or 'node_to_surface' for non-matching "
+            "meshes"), False
 
 
-PAIRINGS = ("node_to_node", "node_to_surface")
+# "auto": node–node where the surfaces' nodes match, surface–surface (the pairing that passes
+# the patch test on non-matching meshes) where they do not.
+PAIRINGS = ("auto", "node_to_node", "node_to_surface", "surface_to_surface")
 
 
 def pair_interfaces(V, interfaces: Sequence, comm):
@@ -160,14 +170,15 @@ def pair_interfaces(V, interfaces: Sequence, comm):
         m = itf.master if rigid else _candidate_surface(V, itf.facet_tags, itf.master)
         if root and error is None:
             try:
-                parts.append((kind, s, _node_pairs(s, m, itf) if kind == "node_to_node"
-                              else m))
+                kind, other = _resolve(kind, s, m, itf, V.mesh.geometry.dim)
+                parts.append((kind, s, other))
                 mus.append(np.full(np.asarray(s["x"]).shape[0], float(itf.mu)))
             except ValueError as e:
                 error = str(e)
     if root and error is None and any(k != "node_to_node" for k, _, _ in parts):
         try:
-            pairs = build_surface_pairs(parts, V.mesh.geometry.dim)
+            pairs = build_surface_pairs(parts, V.mesh.geometry.dim,
+                                        [itf.label for itf in interfaces])
         except ValueError as e:
             error = str(e)
     elif root and error is None:
@@ -175,6 +186,9 @@ def pair_interfaces(V, interfaces: Sequence, comm):
         pairs.interface = np.concatenate([np.full(p.m, i) for i, (_, _, p) in
                                           enumerate(parts)])
     raise_on_every_rank(comm, error)
+    kinds = comm.bcast([k for k, _, _ in parts] if root else None, root=0)
+    for itf, kind in zip(interfaces, kinds):
+        itf.pairing_used = kind   # what "auto" chose (and "rigid" for rigid targets)
     pairs = pairs if root else None
     mu = np.concatenate(mus) if root else np.zeros(0)
     return pairs, mu, comm.bcast(pairs.m if root else None, root=0)
@@ -187,6 +201,20 @@ def _candidate_surface(V, facet_tags, value: int) -> dict:
     if V.mesh.comm.rank == 0:
         s["open_edge"] = flags
     return s
+
+
+def _resolve(kind: str, s: dict, m, itf, dim: int):
+    """The pairing of one interface and what build_surface_pairs needs of the master:
+    NodePairs for node–node, the master surface (or the rigid target) otherwise. "auto" is
+    node–node where the nodes match, else surface–surface (rank 0)."""
+    if kind == "auto":
+        try:
+            return "node_to_node", _node_pairs(s, m, itf)
+        except NonMatchingError:
+            return "surface_to_surface", m
+    if kind == "node_to_node":
+        return kind, _node_pairs(s, m, itf)
+    return kind, m
 
 
 def _node_pairs(s: dict, m: dict, itf) -> NodePairs:

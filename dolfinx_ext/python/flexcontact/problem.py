@@ -61,13 +61,23 @@ class ContactInterface:
 
     ``pairing`` chooses the model for two tagged surfaces (DESIGN.md §2):
 
-    * "node_to_node" (default): each slave node with the master node on its master normal
+    * "auto" (default): "node_to_node" when the two surfaces' nodes match one to one, else
+      "surface_to_surface" (the pairing that passes the contact patch test on non-matching
+      meshes).
+      ``pairing_used`` tells, once the problem is built, which one was taken.
+    * "node_to_node": each slave node with the master node on its master normal
       line. Needs matching interface nodes, and master normals along the lines joining
       them: make the flat surface the master when the other is curved.
     * "node_to_surface": each slave node with its closest point on the master facets
       (non-matching meshes, curved surfaces, either body as slave); pairs are re-made before
       every increment from the current positions, with the F* computed once on all nodes
       of both tagged surfaces (so tag them generously: the candidate zone).
+    * "surface_to_surface": integrated, mortar-type rows (mortar.py): one row per slave
+      node, its weak gap with the dual multiplier basis integrated exactly over the overlaps
+      (segment intersection in 2D, triangles clipped in 3D; 3D quadrilateral facets are not
+      supported yet), along the slave node's normal. Uniform pressure is transmitted exactly
+      across non-matching meshes (the patch test); re-made before every increment like
+      node–surface pairs.
 
     ``tolerance_m`` is the largest tangential offset between node–node pairs (default:
     1e-6 of the surfaces' extent). ``zone_edge`` is what happens when a pair closes at an
@@ -82,7 +92,7 @@ class ContactInterface:
     mu: float
     tolerance_m: Optional[float] = None
     name: str = ""
-    pairing: str = "node_to_node"
+    pairing: str = "auto"
     zone_edge: str = "warn"
 
     def __post_init__(self):
@@ -194,7 +204,7 @@ class ContactProblem:
         self.pairs, self.mu, self.m = pair_interfaces(self.V, self.interfaces, self.comm)
         self.timings["pairing_s"] = time.perf_counter() - t0
         # Node–surface and rigid-target pairs follow the bodies: re-made before each increment.
-        self.repairing = any(i.rigid or i.pairing != "node_to_node" for i in self.interfaces)
+        self.repairing = any(i.pairing_used != "node_to_node" for i in self.interfaces)
         self.pairings = 1
         self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
                                          self.comm, self.options, self.flexibility_method,

@@ -21,7 +21,9 @@ from typing import Optional
 
 import numpy as np
 
-from .projection import (boundary_nodes, closest_points, facet_normals, nodal_normals)
+from .mortar import mortar_rows_2d, mortar_rows_3d
+from .projection import (boundary_nodes, closest_points, facet_measures, facet_normals,
+                         nodal_normals)
 
 
 @dataclass
@@ -73,10 +75,16 @@ class SurfacePairs:
         """Re-make every pair at the current positions x + u_c (u_c: the displacement of
         every contact node, node-major, rigid reference nodes included; None: zero)."""
         xcur = self.x if u_c is None else self.x + np.asarray(u_c).reshape(self.x.shape)
-        width = self.masters.shape[1]
         for p in self.pairers:
             masters, weights, normal, offset, edge = p.pair(xcur)
             rows = p.slave_rows
+            width = self.masters.shape[1]
+            if masters.shape[1] > width:  # mortar rows may reach more master nodes
+                more = masters.shape[1] - width
+                self.masters = np.hstack([self.masters,
+                                          np.repeat(self.masters[:, :1], more, axis=1)])
+                self.weights = np.hstack([self.weights, np.zeros((self.m, more))])
+                width = masters.shape[1]
             pad = width - masters.shape[1]
             self.masters[rows] = np.hstack([masters, np.repeat(masters[:, :1], pad, axis=1)])
             self.weights[rows] = np.hstack([weights, np.zeros((rows.size, pad))])
@@ -131,6 +139,79 @@ class NodeToSurfacePairer:
 
 
 @dataclass
+class SurfaceToSurfacePairer:
+    """Mortar rows of the slave nodes with the dual basis (mortar.py; 2D segments, 3D
+    triangles): slave node j with
+    weight 1, master nodes k with weights M_jk / D_jj, along the slave node's normal
+    (pointing towards the slave body, as the master's outward normal does). A slave node
+    that the master surface does not cover at all gets its closest-point row instead (the
+    fallback pairer), so that every row has a gap.
+    """
+
+    slave_rows: np.ndarray
+    slave_facets: np.ndarray    # (nfs, 2) contact-node rows of the slave segments
+    slave_normal: np.ndarray    # (nfs, 2) their reference outward normals (orientation)
+    fallback: NodeToSurfacePairer
+    cutoff_m: float             # largest slave–master distance of an overlap
+    width: int = 4
+    covered: int = 0            # slave nodes with mortar rows at the last pairing
+
+    def pair(self, xcur):
+        fb = self.fallback
+        masters, weights, normal, offset, edge = fb.pair(xcur)
+        snodes = self.slave_rows
+        local_s = np.searchsorted(snodes, self.slave_facets)
+        mnodes = np.unique(fb.facets)
+        local_m = np.searchsorted(mnodes, fb.facets)
+        Xs, Xm = xcur[snodes], xcur[mnodes]
+        rows_of = mortar_rows_2d if xcur.shape[1] == 2 else mortar_rows_3d
+        D, rows, cols, vals = rows_of(Xs, local_s, self.slave_normal, Xm, local_m,
+                                      fb.facet_normal, self.cutoff_m)
+        full = self._full_measure(Xs, local_s)
+        covered = D > 1e-12 * np.maximum(full, 1e-300)
+        keep = covered[rows] & (vals != 0.0)
+        rows, cols, vals = rows[keep], cols[keep], vals[keep]
+        # Sum the couples of each (row, master node), then one row of weights per slave.
+        key = rows * mnodes.size + cols
+        uniq, inv = np.unique(key, return_inverse=True)
+        summed = np.zeros(uniq.size)
+        np.add.at(summed, inv.reshape(-1), vals)
+        r, c = uniq // mnodes.size, uniq % mnodes.size
+        count = np.bincount(r, minlength=snodes.size)
+        covered &= count > 0
+        self.covered = int(covered.sum())
+        width = max(int(count.max(initial=0)), masters.shape[1])
+        self.width = max(self.width, width)
+        m_out = np.repeat(masters[:, :1], width, axis=1)
+        w_out = np.zeros((snodes.size, width))
+        m_out[:, :masters.shape[1]] = masters
+        w_out[:, :masters.shape[1]] = weights
+        rows_c = np.flatnonzero(covered)
+        starts = np.concatenate([[0], np.cumsum(count)])
+        # Padding of a mortar row: its first master node with weight 0.
+        m_out[rows_c] = mnodes[c[starts[rows_c]]][:, None]
+        w_out[rows_c] = 0.0
+        slot = np.arange(r.size) - starts[r]
+        m_out[r, slot] = mnodes[c]
+        w_out[r, slot] = summed / D[r]
+        fs = facet_normals(Xs, local_s, self.slave_normal)
+        ns = nodal_normals(Xs, local_s, fs)
+        normal[rows_c] = -ns[rows_c]
+        partial = covered & (D < (1 - 1e-9) * full)
+        on_master_edge = partial & np.any(fb.master_edge[m_out] & (w_out != 0), axis=1)
+        edge = np.where(covered, self.fallback.slave_edge | on_master_edge, edge)
+        return m_out, w_out, normal, np.zeros(snodes.size), edge
+
+    @staticmethod
+    def _full_measure(X, facets):
+        """∫ N_j over the whole slave surface: the lumped tributary measure of each node."""
+        nv = facets.shape[1]
+        out = np.zeros(X.shape[0])
+        np.add.at(out, facets.reshape(-1), np.repeat(facet_measures(X, facets) / nv, nv))
+        return out
+
+
+@dataclass
 class RigidPairer:
     """Slave nodes against a rigid analytic target (one reference node, no DOFs)."""
 
@@ -156,13 +237,17 @@ def slave_edge_flags(slave: dict, dim: int) -> np.ndarray:
     return boundary_nodes(facets, dim, np.asarray(slave["x"]).shape[0])
 
 
-def build_surface_pairs(parts: list, dim: int) -> SurfacePairs:
+def build_surface_pairs(parts: list, dim: int, labels=None) -> SurfacePairs:
     """SurfacePairs of several interfaces from their gathered surfaces (rank 0).
 
     ``parts`` holds one tuple per interface: ("node_to_node", slave, NodePairs),
-    ("node_to_surface", slave, master) or ("rigid", slave, RigidTarget), ``slave`` and
-    ``master`` the dicts of ``surface_nodes``. Pairs are made in the reference
-    configuration (rigid targets at their current displacement).
+    ("node_to_surface" or "surface_to_surface", slave, master) or ("rigid", slave,
+    RigidTarget), ``slave`` and ``master`` the dicts of ``surface_nodes``; ``labels`` name
+    the interfaces in errors. Pairs are made in the reference configuration (rigid targets
+    at their current displacement).
+
+    Raises ValueError when a surface–surface interface has no slave node that a facing
+    master facet covers: the tags name surfaces that do not face each other.
     """
     n_slave = [np.asarray(s["x"]).shape[0] for _, s, _ in parts]
     m = int(sum(n_slave))
@@ -183,7 +268,7 @@ def build_surface_pairs(parts: list, dim: int) -> SurfacePairs:
             layouts.append(FixedPairer(rows, np.arange(next_row, next_row + k), other.normal,
                                        edge))
             next_row += k
-        elif kind == "node_to_surface":
+        elif kind in ("node_to_surface", "surface_to_surface"):
             nm = np.asarray(other["x"]).shape[0]
             xs.append(np.asarray(other["x"])); dofs.append(np.asarray(other["dofs"]))
             area_nodes.append(np.asarray(other["area"], float))
@@ -203,11 +288,14 @@ def build_surface_pairs(parts: list, dim: int) -> SurfacePairs:
     for (kind, s, other), lay in zip(parts, layouts):
         if kind == "node_to_node":
             pairers.append(lay)
-        elif kind == "node_to_surface":
+        elif kind in ("node_to_surface", "surface_to_surface"):
             rows, facets, fnormal, edge, master, first = lay
             nm = np.asarray(master["x"]).shape[0]
             master_edge[first:first + nm] = slave_edge_flags(master, dim)
-            pairers.append(NodeToSurfacePairer(rows, facets, fnormal, edge, master_edge))
+            pairer = NodeToSurfacePairer(rows, facets, fnormal, edge, master_edge)
+            if kind == "surface_to_surface":
+                pairer = _mortar_pairer(pairer, s, master, rows[0], dim)
+            pairers.append(pairer)
         else:
             rows, target, edge = lay
             pairers.append(RigidPairer(rows, ref_row, target, edge))
@@ -224,4 +312,24 @@ def build_surface_pairs(parts: list, dim: int) -> SurfacePairs:
     if targets:
         u0[n_nodes - len(targets):] = pairs.virtual_displacement().reshape(-1, dim)
     pairs.repair(u0.reshape(-1))
+    for i, p in enumerate(pairers):
+        if isinstance(p, SurfaceToSurfacePairer) and p.covered == 0:
+            label = labels[i] if labels else f"interface {i}"
+            raise ValueError(
+                f"surface–surface contact ({label}): none of the {p.slave_rows.size} slave "
+                "nodes is covered by a master facet facing it (outward normals opposite, "
+                f"within {p.cutoff_m:.3g} m): the slave and master tags name surfaces that "
+                "do not face each other")
     return pairs
+
+
+def _mortar_pairer(fallback: NodeToSurfacePairer, slave: dict, master: dict, first_row: int,
+                   dim: int) -> SurfaceToSurfacePairer:
+    """The surface–surface pairer of one interface; its overlaps count up to half the
+    diagonal of the two candidate surfaces' bounding box away from the slave surface (the
+    facing test already excludes the far side of a closed surface)."""
+    pts = np.vstack([np.asarray(slave["x"]), np.asarray(master["x"])])
+    cutoff = 0.5 * float(np.linalg.norm(np.ptp(pts, axis=0)))
+    return SurfaceToSurfacePairer(
+        fallback.slave_rows, np.asarray(slave["facets"]) + first_row,
+        np.asarray(slave["facet_normal"]), fallback, cutoff)
