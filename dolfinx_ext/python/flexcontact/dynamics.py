@@ -142,7 +142,7 @@ class ImpactProblem:
             raise ValueError("contact: a rigid target is not supported by ImpactProblem; "
                              "mesh the obstacle and hold it with Dirichlet conditions")
         # Node–surface pairs follow the bodies: re-made before every step (``repair``).
-        self.repairing = repair_pairs and any(i.pairing != "node_to_node"
+        self.repairing = repair_pairs and any(i.pairing_used != "node_to_node"
                                               for i in self.interfaces)
         self.pairings = 1
         self._check_time_step(expected_contact_s)
