@@ -25,7 +25,7 @@ from ..impact_output import contact_metrics
 from ..postprocess import _nodal_contact
 from ..surface_pairs import build_surface_pairs
 from .log_model import rotation
-from .stage2 import MARGIN, approach_time_s
+from .stage2 import MARGIN, approach_time_s, response_duration_s
 
 
 def expected_contact_s(s, dam) -> float:
@@ -80,7 +80,10 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
     u_face0 = static.u.x.array[dam.face_dofs]
     impact = np.array([0.0, s.log_front_point[-1]])
     cells = dam.stress_cells(impact, offset_m)
-    duration = approach_time_s(s) + MARGIN * expected_contact_s(s, dam)
+    # Long enough for the base: its moment peaks about half the dam's first period after
+    # the impact, well after the contact has ended (stage2.response_duration_s).
+    duration = max(approach_time_s(s) + MARGIN * expected_contact_s(s, dam),
+                   response_duration_s(s))
     n = int(round(duration / h))
     records, heel, peak_principal, p_peak = [], -math.inf, -math.inf, 0.0
     solves0 = (dam.back_substitutions["dam_stage2"], log.back_substitutions)

@@ -105,12 +105,13 @@ class MonolithicEvaluator:
     def evaluate(self, scenario) -> dict:
         """The outputs of one scenario (see :data:`OUTPUTS`). Collective over ``comm``."""
         from ..dam.stage1 import solve_stage1
-        from ..dam.stage2 import solve_stage2
+        from ..dam.stage2 import response_duration_s, solve_stage2
         stage1 = solve_stage1(scenario, comm=self.comm)
         self._add("stage1", 1, 1)
         heel = HeelMonitor(scenario, stage1)
         st2 = solve_stage2(scenario, stage1, dt_s=self.dt_s, offset_m=IMPACT_OFFSET_M,
-                           comm=self.comm, on_step=heel)
+                           duration_s=response_duration_s(scenario), comm=self.comm,
+                           on_step=heel)
         t_out = time.perf_counter()
         p = st2.problem
         self._add("stage2", getattr(p.condensation, "factorizations", 1),
