@@ -78,9 +78,11 @@ def main():
         print(f"the evaluator reports no timings(): evaluate() took {ev.get('evaluate_s', 0):.1f} "
               f"process s in all; no split")
     else:
+        outputs = (f"outputs {ev['outputs_s']:.1f}" if "outputs_s" in ev
+                   else "outputs: read inside the steps")
         print(f"evaluator split (process s): set-up/factorizations {setup:.1f}, steps "
-              f"{ev.get('steps_s', float('nan')):.1f}, outputs "
-              f"{ev.get('outputs_s', float('nan')):.1f}")
+              f"{ev.get('steps_s', float('nan')):.1f}, {outputs}; table and report "
+              f"{s['timings_s'].get('report', float('nan')):.1f} s wall")
     print(f"factorizations {s['counts']['factorizations']}, back-substitutions "
           f"{s['counts']['back_substitutions']['total']}; wrote {args.json}")
 

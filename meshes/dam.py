@@ -40,17 +40,25 @@ def build(comm, scenario):
     return _gmsh.generate(comm, f"dam{s.dim}d", model, gdim=s.dim)
 
 
-def profile_points(s) -> list:
-    """Corners of the dam profile (x, vertical) counter-clockwise from the heel, with the
-    tailwater point on the downstream face and the water-line point on the upstream face
-    (each only when strictly between the ends of its face)."""
-    heel, toe, knee, crest_d, crest_u = s.dam_outline()
+def downstream_points(s) -> list:
+    """The downstream face's corners from the toe up to the crest, with the tailwater point
+    when it lies strictly between the toe and the knee or the knee and the crest."""
+    _, toe, knee, crest_d, _ = s.dam_outline()
     down = [toe]
     ht = s.tailwater_level_m
     if 0 < ht < s.dam_height_m and not np.isclose(ht, knee[1]):
         down.append((s.downstream_face_x_m(ht), ht))
     down += [knee, crest_d]
     down.sort(key=lambda p: p[1])
+    return down
+
+
+def profile_points(s) -> list:
+    """Corners of the dam profile (x, vertical) counter-clockwise from the heel, with the
+    tailwater point on the downstream face and the water-line point on the upstream face
+    (each only when strictly between the ends of its face)."""
+    heel, _, _, _, crest_u = s.dam_outline()
+    down = downstream_points(s)
     up = [crest_u]
     if s.water_level_m < s.dam_height_m:
         up.append((0.0, s.water_level_m))
@@ -225,13 +233,8 @@ def build_dam_only(comm, scenario, strip_m, water_levels_m=()):
 def _model_dam_only_2d(s, info, face_levels):
     import gmsh
     geo = gmsh.model.geo
-    heel, toe, knee, crest_d, crest_u = s.dam_outline()
-    down = [toe]
-    ht = s.tailwater_level_m
-    if 0 < ht < s.dam_height_m and not np.isclose(ht, knee[1]):
-        down.append((s.downstream_face_x_m(ht), ht))
-    down += [knee, crest_d]
-    down.sort(key=lambda q: q[1])
+    heel, _, _, _, crest_u = s.dam_outline()
+    down = downstream_points(s)
     pts = [heel] + down + [crest_u] + [(0.0, z) for z in face_levels]
     p = [geo.addPoint(x, y, 0) for x, y in pts]
     lines = [geo.addLine(p[i], p[(i + 1) % len(p)]) for i in range(len(p))]

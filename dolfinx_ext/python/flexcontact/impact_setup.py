@@ -244,3 +244,21 @@ def load_vector(V, L_form, bcs: Sequence) -> Optional[PETSc.Vec]:
     f.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     compat.set_bc(f, list(bcs), scale=0.0)
     return f
+
+
+def unloaded_free_velocity(K: PETSc.Mat, factor, h: float, theta: float, w: PETSc.Vec,
+                           omega: PETSc.Vec) -> PETSc.Vec:
+    """v_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)]: the free velocity of a body with no load and no
+    damping, from its displacement w and velocity ω (one back-substitution with the stored
+    factor of Ŵ)."""
+    y = w.copy()
+    y.axpy(h * theta, omega)
+    r = K.createVecLeft()
+    K.mult(y, r)
+    r.scale(-h)
+    out = K.createVecLeft()
+    factor.solve(r, out)
+    out.axpy(1.0, omega)
+    for o in (y, r):
+        o.destroy()
+    return out

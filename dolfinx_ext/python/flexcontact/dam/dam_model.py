@@ -194,18 +194,8 @@ class DamModel:
 
     def free_velocity(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
         """v_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)] (one back-substitution)."""
-        h = self.dt
-        y = w.copy()
-        y.axpy(h * self.theta, omega)
-        r = self.new_vector()
-        self.K.mult(y, r)
-        r.scale(-h)
-        out = self.new_vector()
-        self.factor.solve(r, out)
+        out = setup.unloaded_free_velocity(self.K, self.factor, self.dt, self.theta, w, omega)
         self.back_substitutions["dam_stage2"] += 1
-        out.axpy(1.0, omega)
-        for o in (y, r):
-            o.destroy()
         return out
 
     def correction(self, r_face: np.ndarray) -> PETSc.Vec:

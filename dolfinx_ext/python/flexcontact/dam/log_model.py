@@ -150,18 +150,8 @@ class LogModel:
 
     def free_velocity(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
         """ω_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)] (one back-substitution), local frame."""
-        h = self.dt
-        y = w.copy()
-        y.axpy(h * self.theta, omega)
-        r = self.new_vector()
-        self.K.mult(y, r)
-        r.scale(-h)
-        out = self.new_vector()
-        self.factor.solve(r, out)
+        out = setup.unloaded_free_velocity(self.K, self.factor, self.dt, self.theta, w, omega)
         self.back_substitutions += 1
-        out.axpy(1.0, omega)
-        for o in (y, r):
-            o.destroy()
         return out
 
     def correction(self, r_front_local: np.ndarray) -> PETSc.Vec:

@@ -90,6 +90,7 @@ class ScenarioEvaluator:
         self.dam = DamModel(base, self.dt, water_levels_m, comm, strip_m=strip_m)
         self.dam.static_state(base.water_level_m)
         self._logs: dict = {}
+        self._steps_s = self._log_mesh_s = 0.0
         self._log_meshes: dict = {}  # a log geometry's mesh, K and unit mass, every density
         self.setup_s = time.perf_counter() - t0
 
@@ -118,8 +119,10 @@ class ScenarioEvaluator:
         if key not in self._logs:
             geometry = (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu)
             if geometry not in self._log_meshes:
+                t0 = time.perf_counter()
                 self._log_meshes[geometry] = LogMesh(*geometry, h_m=self.base.h_impact_m,
                                                      comm=self.dam.comm)
+                self._log_mesh_s += time.perf_counter() - t0
             self._logs[key] = LogModel(
                 s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
                 s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm,
@@ -140,7 +143,16 @@ class ScenarioEvaluator:
         t0 = time.perf_counter()
         out = run_impact(self.dam, log, scenario, static, self.offset_m)
         out["evaluate_s"] = time.perf_counter() - t0
+        self._steps_s += out["evaluate_s"]
         return out
+
+    def timings(self) -> dict:
+        """Cumulative seconds: the dam's set-up (meshing, assembly, its two factorizations and
+        W_face), the logs' set-up (meshing, factorization, condensation) and the time steps
+        with the outputs they monitor."""
+        return {"dam_setup_s": self.setup_s,
+                "log_setup_s": self._log_mesh_s + sum(m.setup_s for m in self._logs.values()),
+                "steps_s": self._steps_s}
 
     def counts(self) -> dict:
         """{"factorizations": {"dam_stage1", "dam_stage2", "log"}, "back_substitutions":
