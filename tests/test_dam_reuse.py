@@ -16,7 +16,7 @@ from flexcontact.dam.log_model import rotate_blocks, rotation
 from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
 from flexcontact.dam.statics import hand_statics
 from flexcontact.dam.stage1 import solve_stage1
-from flexcontact.dam.stage2 import solve_stage2
+from flexcontact.dam.stage2 import response_duration_s, solve_stage2
 
 COMM = MPI.COMM_SELF
 BASE = DamScenario(mesh_size_far_m=6.0, mesh_size_impact_m=0.4)
@@ -33,7 +33,8 @@ def both(evaluator):
     """The base scenario through the evaluator and through the monolithic stages 1 + 2."""
     out = evaluator.evaluate(BASE)
     r1 = solve_stage1(BASE, comm=COMM)
-    r2 = solve_stage2(BASE, r1, dt_s=evaluator.dt, comm=COMM)
+    r2 = solve_stage2(BASE, r1, dt_s=evaluator.dt, duration_s=response_duration_s(BASE),
+                      comm=COMM)
     return out, r1, r2
 
 
