@@ -44,7 +44,8 @@ def summarize(run: dict, rows: list, inputs: list, outputs: list, cfg) -> dict:
 
 
 def figures(folder: Path, summary: dict, rows: list, inputs: list, outputs: list) -> list:
-    paths = plots.envelope_plots(folder, rows, inputs, outputs)
+    plotted = [o for o in outputs if o in stats.ENVELOPE_OUTPUTS] or list(outputs)
+    paths = plots.envelope_plots(folder, rows, inputs, plotted)
     for o, curve in summary.get("exceedance", {}).items():
         if o != "note" and curve["n"]:
             paths.append(plots.exceedance_plot(folder, o, curve))

@@ -11,6 +11,10 @@ from __future__ import annotations
 import numpy as np
 
 KEY_OUTPUTS = ("peak_force_N_per_m", "heel_stress_impact_Pa", "peak_tensile_stress_Pa")
+ENVELOPE_OUTPUTS = KEY_OUTPUTS + ("impulse_N_s_per_m", "contact_duration_s",
+                                  "peak_contact_pressure_Pa")
+"""The outputs an engineer reads off envelope plots (the others — counts, steps, the time
+step — stay in the table)."""
 """The outputs whose most unfavourable case is reported (largest is worst)."""
 
 
