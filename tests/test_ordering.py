@@ -99,3 +99,5 @@ def test_auto_is_metis_in_3d_only(dim, n, expected):
     _, _, info = fc.flexibility(K, dofs)
     assert info["ordering"] == expected
     assert (info["mumps_ordering"] == "metis") == (expected == "metis")
+    # Both supported PETSc generations take our ordering: no fallback to MUMPS's own.
+    assert info["ordering_fallback"] == ""

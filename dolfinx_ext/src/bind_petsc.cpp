@@ -46,6 +46,7 @@ void flexcontact::bind_petsc(py::module& m)
         info["inverse_s"] = r.inverse_s;
         info["ordering"] = r.ordering;
         info["mumps_ordering"] = r.mumps_ordering;
+        info["ordering_fallback"] = r.ordering_fallback;
         info["ordering_s"] = r.ordering_s;
         info["factor_entries"] = r.factor_entries;
         info["factor_flops"] = r.factor_flops;
@@ -74,7 +75,8 @@ factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
 workspace), factorization_s,
 schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s, ordering
-(requested), mumps_ordering (used, INFOG(7)), ordering_s (METIS and the redone analysis,
+(requested), mumps_ordering (used, INFOG(7)), ordering_fallback (why "auto" kept MUMPS's own
+ordering: this PETSc's MUMPS factor cannot take ours; empty otherwise), ordering_s (METIS and the redone analysis,
 part of factorization_s), factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
 factor_memory_mb (INFOG(22)).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on

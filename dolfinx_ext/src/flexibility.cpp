@@ -185,7 +185,18 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
       // PETSc's analysis used MUMPS's automatic choice (PETSc cannot pass ICNTL(7) = 1 and
       // resets ICNTL(7) before it): redo it with the requested ordering.
       double t1 = MPI_Wtime();
-      reanalyse(F.m, N, icntl7, perm_in);
+      try
+      {
+        reanalyse(F.m, N, icntl7, perm_in);
+      }
+      catch (const MumpsLayoutError& e)
+      {
+        // "auto" promises a factorization, not METIS: keep PETSc's own analysis (untouched).
+        if (not out.ordering_auto)
+          throw;
+        out.ordering = "mumps";
+        out.ordering_fallback = e.what();
+      }
       out.ordering_s += MPI_Wtime() - t1;
     }
     if (analysis_only)
@@ -481,6 +492,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   // A given ordering is set by redoing MUMPS's analysis on rank 0's instance (ordering.h);
   // on several ranks MUMPS's automatic choice stays.
   out.ordering = size > 1 ? "mumps" : resolve_ordering(ordering, K);
+  out.ordering_auto = ordering == "auto";
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
 

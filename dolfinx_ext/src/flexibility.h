@@ -54,6 +54,8 @@ struct Flexibility
   std::string ordering;          ///< ordering requested of MUMPS, "auto" resolved ("mumps" on
                                  ///< several ranks)
   std::string mumps_ordering;    ///< ordering MUMPS used, from INFOG(7) ("metis" for ours)
+  bool ordering_auto = false;    ///< "auto" was asked: MUMPS's own choice if ours cannot be set
+  std::string ordering_fallback; ///< why "auto" fell back to MUMPS's own ordering (else empty)
   double ordering_s = 0;         ///< METIS and the redone analysis (within factorization_s)
   std::int64_t factor_entries = 0; ///< entries in the factor, INFOG(29)
   double factor_flops = 0;       ///< flops of the elimination, RINFOG(3)

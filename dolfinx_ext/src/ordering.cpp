@@ -157,7 +157,7 @@ void flexcontact::reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm
   err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
   if (!id or id->job != 1 or id->n != N or id->sym != 2 or id->par != 1
       or id->infog[0] < 0 or id->infog[6] != infog7)
-    throw std::runtime_error(
+    throw MumpsLayoutError(
         "cannot give MUMPS an ordering through this PETSc (its MUMPS factor is not laid out "
         "as expected); use ordering='mumps'");
   if (icntl7 == 1)

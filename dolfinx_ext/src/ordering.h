@@ -12,10 +12,12 @@
 /// the analysis is redone on the same MUMPS instance with ICNTL(7) = 1 and PERM_IN. That
 /// needs MUMPS's own structure, which PETSc keeps first in the factor's private data; it is
 /// checked (job, size, symmetry, INFOG) before use and INFOG(7) = 1 is checked after, so a
-/// PETSc that lays it out otherwise gives a clear error, never a wrong factor.
+/// PETSc that lays it out otherwise never gives a wrong factor: "auto" then keeps MUMPS's own
+/// ordering (and says why in info["ordering_fallback"]), an explicit "metis" is a clear error.
 
 #include <petscmat.h>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -44,9 +46,17 @@ std::string ordering_name(int infog7);
 /// The rows `last` (the Schur variables) are put last, in the given order, as MUMPS needs.
 std::vector<int> metis_pivot_order(Mat K, std::span<const PetscInt> last);
 
+/// @brief The MUMPS instance inside PETSc's factor is not laid out as this build expects
+/// (another PETSc): no ordering can be handed to it; nothing was changed.
+struct MumpsLayoutError : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
 /// @brief Redo MUMPS's analysis of the factor F (after MatCholeskyFactorSymbolic) with the
 /// ordering `icntl7`, and PERM_IN = `perm_in` when icntl7 = 1. Serial only.
-/// @throws std::runtime_error if F's MUMPS instance is not as expected or PERM_IN was not
+/// @throws MumpsLayoutError if F's MUMPS instance is not as expected (F unchanged);
+/// std::runtime_error if PERM_IN was not
 /// used (MUMPS may replace its own orderings: with a Schur complement AMF, PORD, QAMD by AMD)
 void reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm_in);
 } // namespace flexcontact
