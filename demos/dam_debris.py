@@ -44,6 +44,8 @@ parser.add_argument("--log-pitch", type=float, default=10.0, help="degrees, fron
 parser.add_argument("--log-yaw", type=float, default=0.0, help="degrees (3D only)")
 parser.add_argument("--log-length", type=float, default=10.0, help="m")
 parser.add_argument("--log-diameter", type=float, default=0.8, help="m")
+parser.add_argument("--westergaard", action="store_true",
+                    help="stage 2: the reservoir's added mass on the upstream face (Westergaard)")
 parser.add_argument("--gap", type=float, default=0.02, help="log to face, m")
 parser.add_argument("--mu", type=float, default=0.5, help="friction coefficient (stage 2)")
 parser.add_argument("--offset", type=float, default=1.0,
@@ -77,7 +79,7 @@ scenario = DamScenario(
     tailwater_level_m=args.tailwater, uplift_factor=args.uplift,
     log_speed_m_s=args.log_speed, log_pitch_deg=args.log_pitch, log_yaw_deg=args.log_yaw,
     log_length_m=args.log_length, log_diameter_m=args.log_diameter, log_gap_m=args.gap,
-    friction_mu=args.mu)
+    friction_mu=args.mu, westergaard=args.westergaard)
 folder = fc.results_folder("dam_debris")
 
 # %% [markdown]

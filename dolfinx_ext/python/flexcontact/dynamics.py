@@ -87,6 +87,9 @@ class ImpactProblem:
     mass : "consistent" or "lumped" (row sum).
     rayleigh : (α, β) of C = αM + βK.
     loads : UFL linear form of constant external loads, or None.
+    added_mass : optional callable ``(u, v) -> UFL bilinear form`` (kg·m² for u, v in m)
+        added to the mass form, e.g. the water moving with a face (Westergaard); its kinetic
+        energy is part of the account's kinetic energy.
     initial_displacement : a Function on V (m) to start from, e.g. a static state under
         ``loads`` (zeroed at held DOFs); None: zero. Its strain energy is the initial one.
     solver, flexibility, ordering : as for ContactProblem.
@@ -109,7 +112,7 @@ class ImpactProblem:
                  rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
                  solver: Optional[SolverOptions] = None, flexibility: str = "schur",
                  ordering: str = "auto", expected_contact_s: Optional[float] = None,
-                 initial_displacement=None, repair_pairs: bool = True):
+                 initial_displacement=None, repair_pairs: bool = True, added_mass=None):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)
@@ -130,7 +133,8 @@ class ImpactProblem:
         dx = ufl.Measure("dx", domain=self.msh, subdomain_data=cell_tags)
         self.a_form = dolfinx.fem.form(forms.elasticity_form(u, v, materials, dx, kind,
                                                              cell_tags))
-        self.m_form = dolfinx.fem.form(forms.mass_form(u, v, materials, dx))
+        m = forms.mass_form(u, v, materials, dx)
+        self.m_form = dolfinx.fem.form(m + added_mass(u, v) if added_mass is not None else m)
         t0 = time.perf_counter()
         K_probe = dolfinx.fem.petsc.assemble_matrix(self.a_form, bcs=self.bcs)
         K_probe.assemble()

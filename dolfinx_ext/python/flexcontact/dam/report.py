@@ -32,10 +32,12 @@ def _scenario(s: dict, log: dict) -> list:
         f"{_mpa(s['wood_crushing_strength_Pa'])} MPa.", ""]
 
 
-def _limits(st2: dict | None) -> list:
+def _limits(st2: dict | None, westergaard: bool = False) -> list:
+    water = ("Westergaard's added mass of the reservoir on the upstream face included"
+             if westergaard else "no Westergaard added mass of the reservoir on the dam")
     out = ["## Limits of the model", "",
            "* Linear elasticity, small strain and small rotation; no wood crushing, no "
-           "concrete cracking, no Westergaard added mass of the reservoir on the dam, no "
+           f"concrete cracking, {water}, no "
            "water damping. The ratios below say how far each neglected effect is.", ""]
     if st2:
         out += [
@@ -135,7 +137,7 @@ def write_report(folder, summary: dict, mesh_study: list | None = None,
     lines = ["# Floating log against a concrete gravity dam", "",
              "Written by `demos/dam_debris.py`; numbers from `summary.json` (SI, tension "
              "positive" + (", per metre of dam" if s["dim"] == 2 else "") + ").", ""]
-    lines += _scenario(s, summary["log"]) + _limits(st2) + _stage1(st1, unit)
+    lines += _scenario(s, summary["log"]) + _limits(st2, bool(s.get("westergaard"))) + _stage1(st1, unit)
     if st2:
         lines += _stage2(st2, unit)
     if mesh_study:

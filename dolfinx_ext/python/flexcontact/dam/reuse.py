@@ -80,8 +80,9 @@ class ScenarioEvaluator:
         if base.dim != 2:
             raise ValueError(f"dim={base.dim}: the scenario evaluator is 2D only")
         if base.westergaard:
-            raise ValueError("westergaard=True: the reservoir's added mass on the dam is not "
-                             "modelled in stage 2")
+            raise ValueError("westergaard=True: the reservoir's added mass depends on the water "
+                             "level, so one factored dam cannot serve a sweep over it; use the "
+                             "monolithic evaluator (engine.evaluator = \"monolithic\")")
         if not offset_m > 0:
             raise ValueError(f"offset_m={offset_m!r}: must be > 0 m")
         self.base, self.offset_m = base, float(offset_m)

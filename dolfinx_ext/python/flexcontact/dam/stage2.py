@@ -16,10 +16,13 @@ Starts from stage 1 (:mod:`flexcontact.dam.stage1`) on the same mesh and functio
   The pairs are made once from the initial positions and kept (``repair_pairs=False``), as
   the factored-dam evaluator of reuse.py does: over the few milliseconds of contact the log
   slides along the face by far less than an element, and fixed pairs keep the impact
-  linear in the log's speed.
+  linear in the log's speed;
+* ``westergaard=True``: the reservoir's added mass on the upstream face (Westergaard's
+  (7/8) ρ_w sqrt(H_w (H_w − z)) per unit area, acting on the face's normal motion) joins
+  the mass matrix (:func:`westergaard_form`); off by default.
 
-Not modelled: the reservoir's added mass on the dam (Westergaard; ``westergaard=True`` is
-rejected here), water damping, the wood's across-grain softness and crushing.
+Not modelled: water damping and compressibility, the wood's across-grain softness and
+crushing.
 """
 from __future__ import annotations
 
@@ -131,7 +134,28 @@ def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
         V, mesh.cell_tags, {"dam": T.DAM, "foundation": T.FOUNDATION, "log": T.LOG},
         materials, stage2_supports(s, V, mesh), contact, dt_s=dt_s, kind=stage1.kind,
         initial_velocity={"log": tuple(speed)}, loads=loads["dam"] + loads["foundation"],
-        initial_displacement=stage1.u, repair_pairs=False)
+        initial_displacement=stage1.u, repair_pairs=False,
+        added_mass=westergaard_form(s, mesh) if s.westergaard else None)
+
+
+WESTERGAARD_QUADRATURE_DEGREE = 12
+"""The added mass varies as sqrt(depth): smooth on every facet but the one ending at the
+water line (a face node sits there), where the high degree keeps the error of the
+√-endpoint behaviour small (tests/test_dam_impact.py measures the total)."""
+
+
+def westergaard_form(s, mesh):
+    """Westergaard's added mass of the reservoir on the upstream face, as a bilinear form
+    (u, v) -> ∫ m(z) u_x v_x ds over the face below the water, m(z) = (7/8) ρ_w
+    sqrt(H_w (H_w − z)) kg/m² (floating.westergaard_added_mass_kg_m2): the water moving with
+    the face along its normal x, for a rigid dam and incompressible water (Westergaard
+    1933). Its total is (7/12) ρ_w H_w² per metre of face."""
+    x = ufl.SpatialCoordinate(mesh.msh)
+    depth = ufl.max_value(s.water_level_m - x[s.vertical_axis], 0.0)
+    m = 0.875 * s.water_density_kg_m3 * ufl.sqrt(s.water_level_m * depth)
+    ds = ufl.Measure("ds", domain=mesh.msh, subdomain_data=mesh.facet_tags,
+                     metadata={"quadrature_degree": WESTERGAARD_QUADRATURE_DEGREE})
+    return lambda u, v: m * u[0] * v[0] * ds(T.DAM_UPSTREAM)
 
 
 def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
@@ -155,9 +179,6 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     default duration ends before the base responds; :func:`response_duration_s` covers it.
     """
     s = scenario
-    if s.westergaard:
-        raise ValueError("westergaard=True: the reservoir's added mass on the dam is not "
-                         "modelled in stage 2")
     if duration_s is not None and not (math.isfinite(duration_s) and duration_s > 0):
         raise ValueError(f"duration_s={duration_s!r}: must be a finite number > 0 s")
     t0 = time.perf_counter()
@@ -233,9 +254,18 @@ class _Watch:
 def dam_period_estimate_s(s) -> float:
     """Fundamental period of the dam on rigid ground, T₁ = 1.4 H/√E in feet and psi
     (Fenves & Chopra's simplified analysis of concrete gravity dams), i.e.
-    T₁ ≈ 381 H/√E with H in m and E in Pa. Only used to choose how long to simulate."""
+    T₁ ≈ 381 H/√E with H in m and E in Pa. With ``westergaard`` the water's added mass
+    lengthens it by sqrt(1 + m_water / m_dam) (the whole of each mass moving with the mode:
+    an upper bound on the lengthening, which is what a long enough run needs). Only used to
+    choose how long to simulate."""
+    from .statics import polygon_area_centroid
     feet_per_m, pa_per_psi = 1.0 / 0.3048, 6894.757
-    return 1.4 * s.dam_height_m * feet_per_m / math.sqrt(s.concrete.E_Pa / pa_per_psi)
+    T = 1.4 * s.dam_height_m * feet_per_m / math.sqrt(s.concrete.E_Pa / pa_per_psi)
+    if s.westergaard:
+        area, _ = polygon_area_centroid(s.dam_outline())
+        m_water = 7.0 / 12.0 * s.water_density_kg_m3 * s.water_level_m ** 2
+        T *= math.sqrt(1.0 + m_water / (s.concrete.rho_kg_m3 * area))
+    return T
 
 
 def response_duration_s(s) -> float:
