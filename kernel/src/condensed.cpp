@@ -72,11 +72,8 @@ CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
     throw std::invalid_argument(who + "X (contact node coordinates) is not finite");
   const Eigen::Index n_c = X_.rows() * dim_;
   check_flexibility(F_, n_c);
-  if (!constrained_.empty() && static_cast<Eigen::Index>(constrained_.size()) != n_c)
-    throw std::invalid_argument(who + "constrained has " + std::to_string(constrained_.size())
-                                + " entries, expected 0 or n_c = " + std::to_string(n_c));
   check_mu(mu_, pairs_.size());
-  zero_constrained(F_, constrained_);
+  zero_constrained(F_, constrained_, who);
   // gap_operator and initial_gap check the pairs against the node count and dimension.
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
   x0_ = initial_gap(pairs_, X_);
@@ -87,7 +84,7 @@ CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
 void CondensedContact::set_flexibility(Matrix Fstar)
 {
   check_flexibility(Fstar, F_.rows());
-  zero_constrained(Fstar, constrained_);
+  zero_constrained(Fstar, constrained_, who);
   solver_.set_delassus(delassus(B_, Fstar));
   F_ = std::move(Fstar);
 }

@@ -7,14 +7,21 @@
 
 #include "flexcontact/problem.hpp"
 
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace flexcontact
 {
 /// @brief Zeroes the rows and columns of a flexibility that belong to constrained contact
-/// DOFs (K's identity rows would otherwise give them a flexibility of 1).
-inline void zero_constrained(Matrix& F, const std::vector<bool>& constrained)
+/// DOFs (K's identity rows would otherwise give them a flexibility of 1). `constrained` is
+/// empty (none held) or has one entry per row of F; `who` prefixes the error otherwise.
+inline void zero_constrained(Matrix& F, const std::vector<bool>& constrained,
+                             const std::string& who)
 {
+  if (!constrained.empty() && static_cast<Eigen::Index>(constrained.size()) != F.rows())
+    throw std::invalid_argument(who + "constrained has " + std::to_string(constrained.size())
+                                + " entries, expected 0 or n_c = " + std::to_string(F.rows()));
   for (std::size_t i = 0; i < constrained.size(); ++i)
     if (constrained[i])
     {

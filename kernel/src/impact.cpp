@@ -87,11 +87,8 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
     throw std::invalid_argument(who + "theta is " + num(theta_) + "; it must lie in [0.5, 1]");
   const Eigen::Index n_c = X_.rows() * dim_;
   check_flexibility(F_, n_c);
-  if (!constrained_.empty() && static_cast<Eigen::Index>(constrained_.size()) != n_c)
-    throw std::invalid_argument(who + "constrained has " + std::to_string(constrained_.size())
-                                + " entries, expected 0 or n_c = " + std::to_string(n_c));
   check_mu(mu_, pairs_.size());
-  zero_constrained(F_, constrained_);
+  zero_constrained(F_, constrained_, who);
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
   x0_ = initial_gap(pairs_, X_);
   W_ = delassus(B_, F_);
@@ -103,7 +100,7 @@ void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
 {
   check_dt(dt_s);
   check_flexibility(Fhat, F_.rows());
-  zero_constrained(Fhat, constrained_);
+  zero_constrained(Fhat, constrained_, who);
   W_ = delassus(B_, Fhat);
   F_ = std::move(Fhat);
   dt_ = dt_s;
