@@ -30,7 +30,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import elliptic_fit, hertz_fit, profile
+from flexcontact.interface import approach_to_load, elliptic_fit, hertz_fit, profile
 from flexcontact.meshes import hertz2d, tags
 
 parser = argparse.ArgumentParser(description=__doc__)
@@ -88,20 +88,13 @@ problem = fc.ContactProblem(
 
 # %%
 P_target = np.pi * Estar * a_target**2 / (4 * R)
-delta = {"trial": a_target**2 / (2 * R), "final": None}
 
 
-def load(i, t):
-    if i == 1:
-        top_y.value = -delta["trial"]
-        return
-    if delta["final"] is None:
-        P1 = problem.increments[-1].summary.normal_force
-        if P1 <= 0:
-            raise RuntimeError("the trial approach produced no contact force")
-        delta["final"] = delta["trial"] * P_target / P1
-    n = args.increments
-    top_y.value = -(delta["trial"] + (delta["final"] - delta["trial"]) * (i - 1) / (n - 1))
+def set_approach(d):
+    top_y.value = -d
+
+
+load = approach_to_load(problem, set_approach, a_target**2 / (2 * R), P_target, args.increments)
 
 
 # Node–surface results keep their folder; other pairings get their own beside it.

@@ -27,7 +27,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import hertz_fit
+from flexcontact.interface import approach_to_load, hertz_fit
 from flexcontact.meshes import hertz3d, tags
 
 parser = argparse.ArgumentParser(description=__doc__)
@@ -95,20 +95,14 @@ problem = fc.ContactProblem(
 
 # %%
 P_target = 4 * Estar * a_target**3 / (3 * R)   # full-sphere load for a = a_target [N]
-delta = {"trial": 0.5 * a_target**2 / R, "final": None}
 
 
-def load(i, t):
-    if i == 1:
-        top_z.value = -delta["trial"]
-        return
-    if delta["final"] is None:
-        P1 = 4 * problem.increments[-1].summary.normal_force
-        if P1 <= 0:
-            raise RuntimeError("the trial approach produced no contact force")
-        delta["final"] = delta["trial"] * (P_target / P1) ** (2 / 3)
-    n = args.increments
-    top_z.value = -(delta["trial"] + (delta["final"] - delta["trial"]) * (i - 1) / (n - 1))
+def set_approach(d):
+    top_z.value = -d
+
+
+load = approach_to_load(problem, set_approach, 0.5 * a_target**2 / R, P_target, args.increments,
+                        exponent=2 / 3, force_scale=4)  # quarter model: P = 4 × its force
 
 
 folder = fc.results_folder("hertz3d")

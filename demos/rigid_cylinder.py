@@ -22,7 +22,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import hertz_fit, profile
+from flexcontact.interface import approach_to_load, hertz_fit, profile
 from flexcontact.meshes import hertz2d, tags
 
 parser = argparse.ArgumentParser(description=__doc__)
@@ -64,21 +64,13 @@ problem = fc.ContactProblem(
 
 # %%
 P_target = np.pi * Estar * a_target**2 / (4 * R)
-delta = {"trial": a_target**2 / (2 * R), "final": None}
 
 
-def load(i, t):
-    if i == 1:
-        circle.displacement_m = np.array([0.0, -delta["trial"]])
-        return
-    if delta["final"] is None:
-        P1 = problem.increments[-1].summary.normal_force
-        if P1 <= 0:
-            raise RuntimeError("the trial approach produced no contact force")
-        delta["final"] = delta["trial"] * P_target / P1
-    n = args.increments
-    d = delta["trial"] + (delta["final"] - delta["trial"]) * (i - 1) / (n - 1)
+def set_approach(d):
     circle.displacement_m = np.array([0.0, -d])
+
+
+load = approach_to_load(problem, set_approach, a_target**2 / (2 * R), P_target, args.increments)
 
 
 folder = fc.results_folder("rigid_cylinder")

@@ -67,3 +67,31 @@ def elliptic_fit(x, p, frac: float = 0.9):
     if not c1 < 0 < c0:
         return float("nan"), float("nan")
     return float(np.sqrt(-c0 / c1)), float(np.sqrt(c0))
+
+
+def approach_to_load(problem, set_approach, trial_m: float, target_force: float,
+                     increments: int, exponent: float = 1.0, force_scale: float = 1.0):
+    """A ``load(i, t)`` callback for ``ContactProblem.solve`` that reaches a target contact
+    force by prescribed approach δ, when the δ that gives it is not known beforehand.
+
+    Increment 1 applies ``trial_m``; its normal force P₁ (times ``force_scale``, e.g. 4 for
+    a quarter model) fixes the final approach δ = trial · (target_force / P₁)^``exponent``
+    (1 in 2D, where P grows almost linearly with δ; 2/3 for Hertz in 3D, δ ∝ P^(2/3)), and
+    the remaining increments ramp δ linearly from the trial to it (``increments`` ≥ 2).
+    ``set_approach(δ)`` applies an approach in metres (a Dirichlet value, a rigid target's
+    displacement, ...).
+    """
+    final = []
+
+    def load(i, t):
+        if i == 1:
+            set_approach(trial_m)
+            return
+        if not final:
+            P1 = force_scale * problem.increments[-1].summary.normal_force
+            if P1 <= 0:
+                raise RuntimeError("the trial approach produced no contact force")
+            final.append(trial_m * (target_force / P1) ** exponent)
+        set_approach(trial_m + (final[0] - trial_m) * (i - 1) / (max(increments, 2) - 1))
+
+    return load
