@@ -19,7 +19,6 @@ serves the whole sweep (:func:`sweep_time_step_s`). 2D only.
 from __future__ import annotations
 
 import time
-from typing import Iterable
 
 from mpi4py import MPI
 
@@ -27,7 +26,7 @@ from .. import impact_setup as setup
 from .coupled_step import expected_contact_s, run_impact
 from .dam_model import DamModel
 from .log_model import LogMesh, LogModel
-from .stage2 import default_time_step_s
+from .stage2 import sweep_time_step_s
 
 DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
                   "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
@@ -35,17 +34,6 @@ DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "d
                   "water_density_kg_m3", "gravity_m_s2", "mesh_size_far_m",
                   "mesh_size_impact_m", "impact_zone_m", "refine")
 """Parameters fixed by the dam's factorizations: a scenario must share them with the base."""
-
-
-def sweep_time_step_s(scenarios: Iterable) -> float:
-    """One time step (s) for every scenario: the smallest of stage 2's default steps
-    (the log's first wave round trip along x over 40 steps), so that the most demanding
-    scenario (the shortest log round trip) is resolved as a single run would resolve it.
-    The speed does not enter: an elastic impact lasts 2L/c whatever the speed."""
-    steps = [default_time_step_s(s) for s in scenarios]
-    if not steps:
-        raise ValueError("scenarios: empty; give at least one scenario to choose dt_s from")
-    return min(steps)
 
 
 def check_same_dam(base, scenario) -> None:

@@ -120,6 +120,17 @@ def default_time_step_s(s, steps_in_contact: int = 40) -> float:
     return 2.0 * extent / c / steps_in_contact
 
 
+def sweep_time_step_s(scenarios) -> float:
+    """One time step (s) for every scenario: the smallest of stage 2's default steps
+    (the log's first wave round trip along x over 40 steps), so that the most demanding
+    scenario (the shortest log round trip) is resolved as a single run would resolve it.
+    The speed does not enter: an elastic impact lasts 2L/c whatever the speed."""
+    steps = [default_time_step_s(s) for s in scenarios]
+    if not steps:
+        raise ValueError("scenarios: empty; give at least one scenario to choose dt_s from")
+    return min(steps)
+
+
 def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
     """The ImpactProblem of stage 2 (collective)."""
     mesh, V = stage1.mesh, stage1.V
@@ -161,16 +172,14 @@ def westergaard_form(s, mesh):
 def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
                  duration_s: Optional[float] = None, offset_m: float = 1.0,
                  writer=None, write_every: int = 5, stress_every: int = 1,
-                 comm=MPI.COMM_WORLD, on_step=None) -> Stage2Result:
+                 comm=MPI.COMM_WORLD) -> Stage2Result:
     """Run the impact from ``stage1`` (a Stage1Result of the same scenario). Collective.
 
     ``dt_s``: time step (default :func:`default_time_step_s`); ``duration_s``: simulated
     time (default: the approach gap / (speed · x) plus MARGIN × 2L/c of the log); ``offset_m``: the
     distance from the first-contact point on the face at which the largest principal
     stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
-    ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps;
-    ``on_step``: an optional callable ``on_step(problem)`` run after every step (and once
-    before the first), for quantities a caller monitors through the run.
+    ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps.
 
     Besides the contact metrics the result holds, for every step, the base section from
     the dam's displacement (``section_history``), the log's largest rigid rotation and
@@ -202,13 +211,9 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     n = int(round(duration_s / dt))
     if writer is not None:
         writer.write(problem.fields() + stresses(), 0.0)
-    if on_step is not None:
-        on_step(problem)
     for i in range(n):
         rec = problem.step()
         watch.after_step(rec)
-        if on_step is not None:
-            on_step(problem)
         if writer is not None and (i + 1) % write_every == 0:
             writer.write(problem.fields() + stresses(), problem.t)
         if rec.active > 0 and (i % stress_every == 0):
