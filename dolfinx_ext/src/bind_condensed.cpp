@@ -125,11 +125,7 @@ void flexcontact::bind_condensed(py::module& m)
             }
             catch (const ConvergenceError& e)
             {
-              // The report goes along as a plain dict, like step()'s result.
-              py::object error = convergence_error(e.what());
-              error.attr("report") = report_dict(e.report);
-              PyErr_SetObject(convergence_error.ptr(), error.ptr());
-              throw py::error_already_set();
+              raise_convergence_error(convergence_error, e);
             }
             return step_dict(r, c.dim());
           },

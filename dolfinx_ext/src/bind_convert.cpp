@@ -54,4 +54,12 @@ py::dict report_dict(const SolveReport& r)
   d["attempts"] = r.attempts;
   return d;
 }
+
+void raise_convergence_error(py::handle cls, const ConvergenceError& e)
+{
+  py::object error = cls(e.what());
+  error.attr("report") = report_dict(e.report);
+  PyErr_SetObject(cls.ptr(), error.ptr());
+  throw py::error_already_set();
+}
 } // namespace flexcontact

@@ -85,10 +85,7 @@ void flexcontact::bind_impact(py::module& m)
             }
             catch (const ConvergenceError& e)
             {
-              py::object error = convergence_error(e.what());
-              error.attr("report") = report_dict(e.report);
-              PyErr_SetObject(convergence_error.ptr(), error.ptr());
-              throw py::error_already_set();
+              raise_convergence_error(convergence_error, e);
             }
             return step_dict(r, c.dim());
           },

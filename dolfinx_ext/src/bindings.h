@@ -4,6 +4,7 @@
 /// @file bindings.h
 /// @brief Declarations of the parts of the `flexcontact._cpp` module.
 
+#include <flexcontact/increment.hpp>
 #include <flexcontact/pairs.hpp>
 #include <flexcontact/problem.hpp>
 
@@ -40,4 +41,8 @@ pybind11::array_t<double> frames_array(const std::vector<ContactPair>& pairs, in
 
 /// @brief What a solver did, as a dict.
 pybind11::dict report_dict(const SolveReport& r);
+
+/// @brief Raises `e` in Python as the module's ConvergenceError `cls`, its report attached as
+/// a plain dict (attribute `report`), like a step's result.
+[[noreturn]] void raise_convergence_error(pybind11::handle cls, const ConvergenceError& e);
 } // namespace flexcontact
