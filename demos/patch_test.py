@@ -15,7 +15,11 @@
 #
 # The interface is meshed twice: *matching* (both sides the same, non-uniformly spaced
 # nodes) and *non-matching* (2D: the upper side has 1.5 times as many segments, graded the
-# other way; meshes/patch.py). Each pairing (ContactInterface.pairing) is run on each mesh:
+# other way; meshes/patch.py). In 3D the bodies are tetrahedra (`--cell tetrahedron`, the
+# default; non-matching: the upper face structured, the lower unstructured) or hexahedra
+# (`--cell hexahedron`: quadrilateral interface facets, rectangles graded along x and y,
+# the upper face 1.5 times finer and graded the other way when non-matching). Each pairing
+# (ContactInterface.pairing) is run on each mesh:
 #
 # * node_to_node — matching meshes only;
 # * node_to_surface — closest-point projection of the slave nodes (single pass): exact on
@@ -28,8 +32,9 @@
 # every master node (the forces passed on through the weights / tributary measure), the
 # total force N against p·A, and the displacements against the exact linear field.
 #
-# Run: `/usr/bin/python3 demos/patch_test.py [--dim 2|3] [--pairing all|NAME]`
-# (also with `mpirun -n 2`); writes results/patch_test/<dim>d/summary.json.
+# Run: `/usr/bin/python3 demos/patch_test.py [--dim 2|3] [--cell hexahedron] [--pairing
+# all|NAME]` (also with `mpirun -n 2`); writes results/patch_test/<dim>d/summary.json
+# (hexahedra: results/patch_test/3d_hexahedron/).
 
 # %%
 import argparse
@@ -49,7 +54,12 @@ parser.add_argument("--dim", type=int, choices=(2, 3), default=2)
 parser.add_argument("--pairing", choices=("all",) + PAIRINGS, default="all")
 parser.add_argument("--mesh", choices=("both", "matching", "nonmatching"), default="both")
 parser.add_argument("--refine", type=int, default=0, help="halve the element sizes N times")
+parser.add_argument("--cell", choices=("tetrahedron", "hexahedron"), default="tetrahedron",
+                    help="3D cells (2D: triangles)")
 args = parser.parse_args()
+if args.dim == 2 and args.cell != "tetrahedron":
+    parser.error(f"--cell {args.cell} needs --dim 3 (2D meshes are triangles)")
+cell = args.cell if args.dim == 3 else "triangle"
 comm = MPI.COMM_WORLD
 t_start = time.perf_counter()
 
@@ -80,7 +90,7 @@ def exact(geo):
 # %%
 def run(matching, pairing):
     msh, cells, facets, geo = patch.build(comm, dim=args.dim, matching=matching,
-                                          refine=args.refine, **sizes)
+                                          refine=args.refine, cell=cell, **sizes)
     d = args.dim
     V = compat.vector_space(msh)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
@@ -160,7 +170,7 @@ for matching in meshes:
                     f"pressure error {r['pressure_error_rel_slave']:.2e} (slave), "
                     f"{r['pressure_error_rel_master']:.2e} (master), N {r['N']:.6e} "
                     f"(ref {r['N_ref']:.6e}), u error {r['u_error_rel']:.2e}")
-            print(f"{args.dim}D {mesh_name:13s} {pairing:19s} {text}")
+            print(f"{args.dim}D {cell} {mesh_name:13s} {pairing:19s} {text}")
 
 # %% [markdown]
 # ## Summary
@@ -168,9 +178,10 @@ for matching in meshes:
 # against `p_ref`; `pressure_error_rel` is max |p_node/p − 1| over slave and master nodes.
 
 # %%
-folder = fc.results_folder(f"patch_test/{args.dim}d")
+folder = fc.results_folder(f"patch_test/{args.dim}d"
+                           + ("_hexahedron" if cell == "hexahedron" else ""))
 fc.write_summary(folder, {
-    "demo": "patch_test", "dim": args.dim, "units": "SI (m, Pa; N/m in 2D)",
+    "demo": "patch_test", "dim": args.dim, "cell": cell, "units": "SI (m, Pa; N/m in 2D)",
     "materials": {"lower": {"E_Pa": steel.E_Pa, "nu": steel.nu},
                   "upper": {"E_Pa": steel.E_Pa, "nu": steel.nu}},
     "mu": 0.0, "delta_m": delta_m, "refine": args.refine,

@@ -25,10 +25,11 @@ from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETR
 
 PROGRESSION_2D = 1.15  # ratio of neighbouring interface segments in 2D (any value matches)
 NONMATCHING_RATIO = 1.5  # upper/lower interface segment counts (2D) or sizes (3D), non-matching
+CELLS = {2: ("triangle",), 3: ("tetrahedron", "hexahedron")}
 
 
 def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=0.02,
-          h_upper=0.03, refine=0, matching=True):
+          h_upper=0.03, refine=0, matching=True, cell="tetrahedron"):
     """Build the patch-test mesh on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -39,6 +40,11 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         h_lower, h_upper: element sizes (m) at the lower body's bottom and the upper body's
             top; the interface gets min(h_lower, h_upper).
         refine: each level halves both sizes.
+        cell: in 3D, "tetrahedron" (unstructured, above) or "hexahedron": both bodies
+            structured (transfinite, recombined), their interface faces in rectangles
+            graded geometrically along x and y (ratio PROGRESSION_2D); non-matching: the
+            upper face has NONMATCHING_RATIO times as many segments per edge, graded the
+            other way; vertical layers of the mean of the interface and outer sizes.
         matching: True: the interface meshes are identical copies, node for node (above);
             False: non-matching interface meshes — in 2D the upper body's interface gets
             NONMATCHING_RATIO times as many segments, graded the other way (no interior node
@@ -54,6 +60,8 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         raise ValueError(f"dim={dim!r}: must be 2 or 3")
     if not isinstance(matching, bool):
         raise ValueError(f"matching={matching!r}: must be True or False")
+    if cell not in CELLS[dim]:
+        raise ValueError(f"cell={cell!r}: in {dim}D must be one of {', '.join(CELLS[dim])}")
     w = _check.positive("width", width)
     H1 = _check.positive("lower_height", lower_height)
     H2 = _check.positive("upper_height", upper_height)
@@ -62,7 +70,7 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
     hu = _check.positive("h_upper", h_upper) / 2 ** refine
     hi = min(hl, hu)
     info = dict(dim=dim, width=w, lower_height=H1, upper_height=H2, h_lower=hl, h_upper=hu,
-                h_interface=hi, area=w * w if dim == 3 else w)
+                h_interface=hi, area=w * w if dim == 3 else w, cell=cell)
     # Element size (m) as a function of height: h_i at the interface, growing linearly to
     # h_lower at z = −H1 and to h_upper at z = H2. (|z| − z)/2 is −z below the interface and
     # 0 above, (|z| + z)/2 the reverse; gmsh's MathEval has no conditionals.
@@ -163,4 +171,58 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
             gmsh.model.mesh.getNodes(2, f, includeBoundary=True)[0] for f in master)))
         return info
 
-    return _gmsh.generate(comm, f"patch_{dim}d", model_3d if dim == 3 else model_2d, gdim=dim)
+    def model_hex():
+        return _hexahedra(w, H1, H2, hl, hu, hi, matching, info)
+
+    model = model_2d if dim == 2 else (model_hex if cell == "hexahedron" else model_3d)
+    return _gmsh.generate(comm, f"patch_{dim}d", model, gdim=dim)
+
+
+def _graded_curves(volume, counts, ratio):
+    """Transfinite curves of a box: segments counts[axis] along each axis, spacing growing
+    by ``ratio`` per segment towards +x, +y (vertical edges uniform)."""
+    import gmsh
+    curves = {abs(t) for _, t in gmsh.model.getBoundary(
+        gmsh.model.getBoundary([(3, volume)], combined=False, oriented=False),
+        combined=False, oriented=False)}
+    for c in sorted(curves):
+        ends = [p for _, p in gmsh.model.getBoundary([(1, c)], oriented=False)]
+        a, b = (gmsh.model.getValue(0, p, []) for p in ends)
+        axis = int(abs(b - a).argmax())
+        coef = 1.0 if axis == 2 else (ratio if b[axis] > a[axis] else 1.0 / ratio)
+        gmsh.model.mesh.setTransfiniteCurve(c, counts[axis] + 1, "Progression", coef)
+
+
+def _hexahedra(w, H1, H2, hl, hu, hi, matching, info):
+    """The two bodies in hexahedra (transfinite, recombined); see ``build``'s ``cell``."""
+    import gmsh
+    occ = gmsh.model.occ
+    lower = occ.addBox(0, 0, -H1, w, w, H1)
+    upper = occ.addBox(0, 0, 0, w, w, H2)
+    occ.synchronize()
+    n = max(2, math.ceil(w / hi - 1e-9))
+    n_up = n if matching else max(n + 1, round(NONMATCHING_RATIO * n))
+    layers = [max(1, math.ceil(H / (0.5 * (hi + h)) - 1e-9)) for H, h in ((H1, hl), (H2, hu))]
+    _graded_curves(lower, (n, n, layers[0]), PROGRESSION_2D)
+    _graded_curves(upper, (n_up, n_up, layers[1]),
+                   PROGRESSION_2D if matching else 1.0 / PROGRESSION_2D)
+    for v in (lower, upper):
+        for _, f in gmsh.model.getBoundary([(3, v)], combined=False, oriented=False):
+            gmsh.model.mesh.setTransfiniteSurface(abs(f))
+            gmsh.model.mesh.setRecombine(2, abs(f))
+        gmsh.model.mesh.setTransfiniteVolume(v)
+    both = [lower, upper]
+    _gmsh.physical(3, [lower], BASE, NAMES[BASE])
+    _gmsh.physical(3, [upper], UPPER, NAMES[UPPER])
+    _gmsh.physical(2, _gmsh.faces_in(0, 0, -H1, w, w, -H1, [lower]), FIXED, NAMES[FIXED])
+    _gmsh.physical(2, _gmsh.faces_in(0, 0, H2, w, w, H2, [upper]), LOADED, NAMES[LOADED])
+    _gmsh.physical(2, _gmsh.faces_in(0, 0, 0, w, w, 0, [lower]), MASTER, NAMES[MASTER])
+    _gmsh.physical(2, _gmsh.faces_in(0, 0, 0, w, w, 0, [upper]), SLAVE, NAMES[SLAVE])
+    _gmsh.physical(2, _gmsh.faces_in(0, 0, -H1, 0, w, H2, both), SYMMETRY_X, NAMES[SYMMETRY_X])
+    _gmsh.physical(2, _gmsh.faces_in(0, 0, -H1, w, 0, H2, both), SYMMETRY_Y, NAMES[SYMMETRY_Y])
+    gmsh.model.mesh.generate(3)
+    info["h_interface"] = w / n
+    info["n_contact_nodes"] = (n + 1) ** 2
+    if not matching:
+        info["n_contact_nodes_upper"] = (n_up + 1) ** 2
+    return info

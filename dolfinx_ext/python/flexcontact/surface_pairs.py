@@ -22,6 +22,7 @@ from typing import Optional
 import numpy as np
 
 from .mortar import mortar_rows_2d, mortar_rows_3d
+from .mortar_3d import full_measures
 from .projection import (boundary_nodes, closest_points, facet_measures, facet_normals,
                          nodal_normals)
 
@@ -141,7 +142,7 @@ class NodeToSurfacePairer:
 @dataclass
 class SurfaceToSurfacePairer:
     """Mortar rows of the slave nodes with the dual basis (mortar.py; 2D segments, 3D
-    triangles): slave node j with
+    triangles and quadrilaterals): slave node j with
     weight 1, master nodes k with weights M_jk / D_jj, along the slave node's normal
     (pointing towards the slave body, as the master's outward normal does). A slave node
     that the master surface does not cover at all gets its closest-point row instead (the
@@ -149,8 +150,8 @@ class SurfaceToSurfacePairer:
     """
 
     slave_rows: np.ndarray
-    slave_facets: np.ndarray    # (nfs, 2) contact-node rows of the slave segments
-    slave_normal: np.ndarray    # (nfs, 2) their reference outward normals (orientation)
+    slave_facets: np.ndarray    # (nfs, nv) contact-node rows of the slave facets
+    slave_normal: np.ndarray    # (nfs, d) their reference outward normals (orientation)
     fallback: NodeToSurfacePairer
     cutoff_m: float             # largest slave–master distance of an overlap
     width: int = 4
@@ -167,7 +168,7 @@ class SurfaceToSurfacePairer:
         rows_of = mortar_rows_2d if xcur.shape[1] == 2 else mortar_rows_3d
         D, rows, cols, vals = rows_of(Xs, local_s, self.slave_normal, Xm, local_m,
                                       fb.facet_normal, self.cutoff_m)
-        full = self._full_measure(Xs, local_s)
+        full = self._full_measure(Xs, local_s, self.slave_normal)
         covered = D > 1e-12 * np.maximum(full, 1e-300)
         keep = covered[rows] & (vals != 0.0)
         rows, cols, vals = rows[keep], cols[keep], vals[keep]
@@ -203,11 +204,15 @@ class SurfaceToSurfacePairer:
         return m_out, w_out, normal, np.zeros(snodes.size), edge
 
     @staticmethod
-    def _full_measure(X, facets):
-        """∫ N_j over the whole slave surface: the lumped tributary measure of each node."""
+    def _full_measure(X, facets, reference):
+        """∫ N_j over the whole slave surface (the lumped tributary measure of each node on
+        segments, triangles and parallelograms), as the mortar rows integrate it."""
         nv = facets.shape[1]
         out = np.zeros(X.shape[0])
-        np.add.at(out, facets.reshape(-1), np.repeat(facet_measures(X, facets) / nv, nv))
+        if X.shape[1] == 3:
+            np.add.at(out, facets.reshape(-1), full_measures(X, facets, reference).reshape(-1))
+        else:
+            np.add.at(out, facets.reshape(-1), np.repeat(facet_measures(X, facets) / nv, nv))
         return out
 
 
