@@ -96,7 +96,7 @@ def mesh_sizes(dim):
 
 
 def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tolerance=1e-10,
-        pairing="node_to_node", matching=True):
+        pairing="node_to_node", matching=True, cell=None):
     """Solve the case and return its measurements (the same dict on every rank).
 
     ``chain``: the kernel's solvers, in order (SolverOptions.chain; empty: the default chain,
@@ -104,9 +104,12 @@ def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tol
     relative natural-map residual at which an answer is accepted. The active-set method
     (the seed's) is exact once its states settle, so its answer is exact up to round-off.
     ``pairing``: the ContactInterface's; ``matching``: False for non-matching interface
-    meshes (meshes/patch.py).
+    meshes (meshes/patch.py); ``cell``: its cell kind (None: triangles in 2D, tetrahedra in
+    3D; "hexahedron" in 3D).
     """
-    msh, cells, facets, geo = patch.build(comm, dim=dim, matching=matching, **mesh_sizes(dim))
+    cell = cell or ("tetrahedron" if dim == 3 else "triangle")
+    msh, cells, facets, geo = patch.build(comm, dim=dim, matching=matching, cell=cell,
+                                          **mesh_sizes(dim))
     H1, H2, A = geo["lower_height"], geo["upper_height"], geo["area"]
     lower, upper, mu = materials(dim, case)
     kind = "3d" if dim == 3 else "plane_strain"
@@ -183,7 +186,8 @@ def run(dim, case, comm=MPI.COMM_WORLD, increments=1, chain=("active_set",), tol
         s = summaries[-1]
         order = np.lexsort(xs.T[::-1])
         out = {
-            "dim": dim, "case": case, "mu": mu, "ranks": comm.size, "pairs": int(m),
+            "dim": dim, "cell": cell, "case": case, "mu": mu, "ranks": comm.size,
+            "pairs": int(m),
             "pairing": pairing, "matching": matching,
             "increments": increments, "flexibility": problem.flex_info.get("method"),
             "p_exact_Pa": p, "A": A, "N": s.normal_force, "N_exact": p * A,
@@ -220,10 +224,13 @@ def main(argv=None):
     ap.add_argument("--pairing", default="node_to_node",
                     help="comma-separated pairings (ContactInterface.pairing)")
     ap.add_argument("--nonmatching", action="store_true", help="non-matching interface meshes")
+    ap.add_argument("--cell", choices=("tetrahedron", "hexahedron"), default=None,
+                    help="3D cells (default tetrahedra)")
     args = ap.parse_args(argv)
     chain = [] if args.chain == "default" else args.chain.split(",")
     results = [run(int(d), c, increments=args.increments, chain=chain, tolerance=args.tolerance,
-                   pairing=pg, matching=not args.nonmatching)
+                   pairing=pg, matching=not args.nonmatching,
+                   cell=args.cell if int(d) == 3 else None)
                for d in args.dims.split(",") for c in args.cases.split(",")
                for pg in args.pairing.split(",")]
     if MPI.COMM_WORLD.rank == 0:
