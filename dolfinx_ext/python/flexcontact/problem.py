@@ -74,8 +74,9 @@ class ContactInterface:
       of both tagged surfaces (so tag them generously: the candidate zone).
     * "surface_to_surface": integrated, mortar-type rows (mortar.py): one row per slave
       node, its weak gap with the dual multiplier basis integrated exactly over the overlaps
-      (segment intersection in 2D, triangles clipped in 3D; 3D quadrilateral facets are not
-      supported yet), along the slave node's normal. Uniform pressure is transmitted exactly
+      (segment intersection in 2D; in 3D triangle and quadrilateral facets, i.e. tetrahedral
+      and hexahedral meshes, clipped in the slave facet's plane: exact on triangles and
+      parallelograms), along the slave node's normal. Uniform pressure is transmitted exactly
       across non-matching meshes (the patch test); re-made before every increment like
       node–surface pairs.
 
