@@ -29,7 +29,7 @@ CELLS = {2: ("triangle",), 3: ("tetrahedron", "hexahedron")}
 
 
 def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=0.02,
-          h_upper=0.03, refine=0, matching=True, cell="tetrahedron"):
+          h_upper=0.03, refine=0, matching=True, cell=None):
     """Build the patch-test mesh on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -40,11 +40,12 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         h_lower, h_upper: element sizes (m) at the lower body's bottom and the upper body's
             top; the interface gets min(h_lower, h_upper).
         refine: each level halves both sizes.
-        cell: in 3D, "tetrahedron" (unstructured, above) or "hexahedron": both bodies
-            structured (transfinite, recombined), their interface faces in rectangles
-            graded geometrically along x and y (ratio PROGRESSION_2D); non-matching: the
-            upper face has NONMATCHING_RATIO times as many segments per edge, graded the
-            other way; vertical layers of the mean of the interface and outer sizes.
+        cell: None (triangles in 2D, tetrahedra in 3D); in 3D "tetrahedron" (unstructured,
+            above) or "hexahedron": both bodies structured (transfinite, recombined), their
+            interface faces in rectangles graded geometrically along x and y (ratio
+            PROGRESSION_2D); non-matching: the upper face has NONMATCHING_RATIO times as
+            many segments per edge, graded the other way; vertical layers of the mean of
+            the interface and outer sizes.
         matching: True: the interface meshes are identical copies, node for node (above);
             False: non-matching interface meshes — in 2D the upper body's interface gets
             NONMATCHING_RATIO times as many segments, graded the other way (no interior node
@@ -60,6 +61,7 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         raise ValueError(f"dim={dim!r}: must be 2 or 3")
     if not isinstance(matching, bool):
         raise ValueError(f"matching={matching!r}: must be True or False")
+    cell = CELLS[dim][0] if cell is None else cell
     if cell not in CELLS[dim]:
         raise ValueError(f"cell={cell!r}: in {dim}D must be one of {', '.join(CELLS[dim])}")
     w = _check.positive("width", width)

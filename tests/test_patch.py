@@ -33,6 +33,7 @@ from mpi4py import MPI
 
 import patch_case
 from conftest import mpirun
+from flexcontact import compat
 from flexcontact.meshes import patch, surface_nodes, tags
 
 COMM = MPI.COMM_WORLD
@@ -104,9 +105,33 @@ def test_mesh_rejects_bad_parameters():
                          ({"lower_height": 0}, "lower_height=0"),
                          ({"h_upper": float("nan")}, "h_upper=nan"),
                          ({"refine": 1.5}, "refine=1.5"), ({"dim": True}, "dim=True"),
-                         ({"matching": "no"}, "matching='no'")]:
+                         ({"matching": "no"}, "matching='no'"),
+                         ({"dim": 2, "cell": "hexahedron"}, "cell='hexahedron'"),
+                         ({"cell": "prism"}, "cell='prism'")]:
         with pytest.raises(ValueError, match=word):
             patch.build(COMM, **kwargs)
+
+
+@pytest.mark.parametrize("matching", [True, False], ids=["matching", "nonmatching"])
+def test_hexahedral_mesh(matching):
+    # cell="hexahedron": hexahedra only; interfaces of (n + 1)² nodes, n = w / h_i, the upper
+    # one (n_up + 1)² with n_up = round(1.5 n) when non-matching, graded the other way (no
+    # interior node of one side on an interior grid line of the other).
+    msh, cells, facets, info = patch.build(COMM, dim=3, cell="hexahedron", matching=matching,
+                                           **patch_case.mesh_sizes(3))
+    assert compat.cell_type_name(msh) == "hexahedron" and info["cell"] == "hexahedron"
+    n = round(info["width"] / info["h_interface"])
+    xs = surface_nodes(msh, facets, tags.SLAVE)
+    xm = surface_nodes(msh, facets, tags.MASTER)
+    assert len(xm) == (n + 1) ** 2
+    order = lambda x: x[np.lexsort(x.T[::-1])]  # noqa: E731
+    if matching:
+        assert np.allclose(order(xs), order(xm), rtol=0, atol=1e-12 * info["width"])
+        return
+    assert len(xs) == (round(patch.NONMATCHING_RATIO * n) + 1) ** 2
+    lines_s, lines_m = np.unique(xs[:, 0]), np.unique(xm[:, 0])
+    shared = np.abs(lines_s[1:-1, None] - lines_m[None, 1:-1]) <= 1e-9 * info["width"]
+    assert not shared.any()
 
 
 # ---- (a) stick: different materials, equal lateral strain --------------------------------
