@@ -15,9 +15,11 @@ shape functions are evaluated through its inverse bilinear map (Newton's method,
 from the parallelogram's answer). On a parallelogram that map is affine, so N is bilinear
 in the plane and ψ_a N̂_c (ψ = A N is bilinear too) is a polynomial of degree 4: Radon's
 7-point rule, of degree 5, integrates it exactly. On a quadrilateral that is not a
-parallelogram the inverse map is not polynomial and the rule is accurate, not exact; a
-warped (non-planar) slave quadrilateral is replaced by its projection on its mean plane,
-for D and for the full measures (full_measures) alike.
+parallelogram the inverse map is not polynomial and each integral is accurate, not exact;
+the identities the patch test rests on (Σ_k M_jk = D_jj, Σ_k M_jk x̂_k = D_jj x_j on flat
+surfaces, Σ_j D_jj = the covered area) hold at the rule's points and so stay exact. A warped
+(non-planar) slave quadrilateral is replaced by its projection on its mean plane, for D and
+for the full measures (full_measures) alike.
 
 Memory: the candidate couples (facing, bounding boxes within the cutoff) are searched in
 batches of slave facets, at most a few million slave × master tests at a time.
