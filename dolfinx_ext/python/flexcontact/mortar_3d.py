@@ -21,8 +21,9 @@ surfaces, Σ_j D_jj = the covered area) hold at the rule's points and so stay ex
 (non-planar) slave quadrilateral is replaced by its projection on its mean plane, for D and
 for the full measures (full_measures) alike.
 
-Memory: the candidate couples (facing, bounding boxes within the cutoff) are searched in
-batches of slave facets, at most a few million slave × master tests at a time.
+Memory: the candidate couples (facing, bounding boxes within the cutoff, bounding rectangles
+overlapping in the slave plane) are searched in batches, at most a few million slave ×
+master tests at a time; only those couples are clipped, one by one.
 """
 from __future__ import annotations
 
@@ -184,19 +185,32 @@ def full_measures(X, facets, reference):
     return out
 
 
-def _candidates(S, ns, Mt, nm, cutoff_m):
-    """(slave, master) facet couples that face each other (opposite normals) and whose
-    bounding boxes, the slave's grown by the cutoff, meet; in batches of slave facets."""
+def _candidates(S, ns, frames, Mt, nm, cutoff_m):
+    """(slave, master) facet couples that face each other (opposite normals), whose
+    bounding boxes (the slave's grown by the cutoff) meet, whose master corners are on
+    average within the cutoff of the slave plane, and whose bounding rectangles in that
+    plane overlap; in batches of slave facets (the slave × master tests) and of couples."""
+    c, E, T = frames
     lo_s, hi_s = S.min(axis=1) - cutoff_m, S.max(axis=1) + cutoff_m
     lo_m, hi_m = Mt.min(axis=1), Mt.max(axis=1)
+    t_lo, t_hi = T.min(axis=1), T.max(axis=1)
+    tol = 1e-12 * float(np.ptp(T.reshape(-1, 2), axis=0).max(initial=0.0))
     s_idx, k_idx = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
     chunk = max(1, _BATCH // max(Mt.shape[0], 1))
     for a in range(0, S.shape[0], chunk):
         b = min(a + chunk, S.shape[0])
         meet = np.all((lo_m[None] <= hi_s[a:b, None]) & (hi_m[None] >= lo_s[a:b, None]), axis=2)
         si, ki = np.nonzero(meet & ((ns[a:b] @ nm.T) < 0.0))
-        s_idx.append(si + a)
-        k_idx.append(ki)
+        si += a
+        for q in range(0, si.size, _BATCH // 64):
+            s, k = si[q:q + _BATCH // 64], ki[q:q + _BATCH // 64]
+            rel = Mt[k] - c[s][:, None]                                  # (n, nvm, 3)
+            near = np.abs(np.einsum("nvk,nk->nv", rel, ns[s])).mean(axis=1) <= cutoff_m
+            P = np.einsum("nvk,nik->nvi", rel, E[s])                     # in the slave plane
+            inside = np.all((P.min(axis=1) <= t_hi[s] + tol)
+                            & (P.max(axis=1) >= t_lo[s] - tol), axis=1)
+            s_idx.append(s[near & inside])
+            k_idx.append(k[near & inside])
     return np.concatenate(s_idx), np.concatenate(k_idx)
 
 
@@ -216,15 +230,12 @@ def mortar_rows_3d(Xs, slave_facets, slave_ref, Xm, master_facets, master_ref, c
     S, Mt = Xs[slave_facets], Xm[master_facets]                 # (nf, nv, 3)
     ns = facet_normals(Xs, slave_facets, slave_ref)
     nm = facet_normals(Xm, master_facets, master_ref)
-    s_idx, k_idx = _candidates(S, ns, Mt, nm, cutoff_m)
     c, E, T = slave_frames(S, ns)
+    s_idx, k_idx = _candidates(S, ns, (c, E, T), Mt, nm, cutoff_m)
     Me = np.zeros((S.shape[0], nvs, nvs))
     couples = []
     for s, k in zip(s_idx, k_idx):
-        rel_m = Mt[k] - c[s]
-        if np.abs(rel_m @ ns[s]).mean() > cutoff_m:
-            continue
-        got = couple_integrals(T[s], rel_m @ E[s].T)
+        got = couple_integrals(T[s], (Mt[k] - c[s]) @ E[s].T)
         if got is None:
             continue
         Me[s] += got[0]
