@@ -18,7 +18,7 @@ import flexcontact as fc
 from flexcontact import compat, forms
 from flexcontact.meshes import tags
 
-from peers_cases import MU_FRICTION, R_M, STEEL, Case
+from peers_cases import R_M, STEEL, Case
 
 
 class Setup:

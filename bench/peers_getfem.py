@@ -125,7 +125,8 @@ class GetfemHertz:
         u1 = np.asarray(self.md.variable("u1")).copy()
         u1[self.top_dofs] = -delta_m
         self.md.set_variable("u1", u1)
-        out = self.md.solve("max_res", RELATIVE_RESIDUAL * target_force(self.case), "max_iter", 100, "lsolver", "mumps")
+        out = self.md.solve("max_res", RELATIVE_RESIDUAL * target_force(self.case),
+                            "max_iter", 100, "lsolver", "mumps")
         nbit, converged = (out if isinstance(out, (tuple, list)) else (out, True))
         if not converged:
             raise RuntimeError(f"GetFEM did not converge at δ = {delta_m} m")

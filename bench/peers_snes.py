@@ -53,7 +53,7 @@ def _vertex_rule(dim: int) -> dict:
             "quadrature_degree": 1}
 
 
-def _gap_and_normal(case: Case, s: Setup, u, delta):
+def _gap_and_normal(case: Case, u, delta):
     x = ufl.SpatialCoordinate(case.msh)
     if case.dim == 2:
         c = ufl.as_vector((0.0, R_M)) - ufl.as_vector((0.0, 1.0)) * delta
@@ -75,7 +75,7 @@ class PenaltySNES:
         V = self.s.V
         self.u = dolfinx.fem.Function(V)
         self.delta = dolfinx.fem.Constant(case.msh, PETSc.ScalarType(0.0))
-        g, n = _gap_and_normal(case, self.s, self.u, self.delta)
+        g, n = _gap_and_normal(case, self.u, self.delta)
         ds = ufl.Measure("ds", domain=case.msh, subdomain_data=case.facets,
                          metadata=_vertex_rule(case.dim))
         k = dolfinx.fem.Constant(case.msh, PETSc.ScalarType(kappa_Pa_m))
