@@ -97,8 +97,8 @@ def _split_table(cases: list[dict]) -> list[str]:
     out = ["| case | ordering plain / Schur | plain factor entries | Schur factor entries | "
            "factorization with Schur s | Schur extraction s | dense inverse s | W s | "
            "set-up s | first increment s | (c) − 2(d) − local solve ms | linear solve s | "
-           "local solver (iterations) |",
-           "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+           "local solver (iterations) | case wall / CPU s | load average |",
+           "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|"]
     for c in cases:
         if "error" in c:
             continue
@@ -112,7 +112,9 @@ def _split_table(cases: list[dict]) -> list[str]:
             f"{_f(con['first_increment_s'])} | "
             f"{_f((c['increment_s'] - 2 * c['backsolve_s'] - c['contact_solve_s']) * 1e3, 1)} | "
             f"{_f(lin['solve_s'])} | "
-            f"{last['solver']} ({last['iterations']}) |")
+            f"{last['solver']} ({last['iterations']}) | {c['wall_s']:.0f} / "
+            f"{_f(c.get('process_cpu_s'), 0)} | "
+            + " → ".join(f"{x:.1f}" for x in c.get("load_average", [])) + " |")
     return out
 
 

@@ -63,6 +63,7 @@ def run_case(name: str, timeout_s: float, increments: int, repeat: int) -> dict:
     env["PYTHONPATH"] = os.pathsep.join(
         [str(REPO / "dolfinx_ext" / "python")] + [p for p in [env.get("PYTHONPATH")] if p])
     log = HERE / f".{name}.log"
+    load = os.getloadavg()[0]
     t0 = time.perf_counter()
     with open(log, "w") as f:
         child = subprocess.Popen([sys.executable, str(HERE / "case.py"), "--spec",
@@ -80,6 +81,9 @@ def run_case(name: str, timeout_s: float, increments: int, repeat: int) -> dict:
     out = json.loads(lines[-1][len("RESULT "):])
     out["wall_s"] = wall
     out["process_maxrss_mb"] = usage.ru_maxrss / 1024 if usage else None
+    # CPU time well below the wall time: the case waited for the shared cores
+    out["process_cpu_s"] = usage.ru_utime + usage.ru_stime if usage else None
+    out["load_average"] = [load, os.getloadavg()[0]]
     return out
 
 
