@@ -3,7 +3,7 @@ factorization, in one run; writes bench/RESULTS.md and bench/results.json.
 
     /usr/bin/python3 bench/run.py            # the default set, about 15 minutes here
     /usr/bin/python3 bench/run.py --full     # adds 2D ≥ 1M and 3D ≥ 300k DOFs (see README)
-    /usr/bin/python3 bench/run.py --cases 2d_15k_c100 3d_6k_c100   # a subset
+    /usr/bin/python3 bench/run.py --cases 2d_20k_c100 3d_11k_c160   # a subset
 
 Each case runs in its own process (bench/case.py) on a Hertz mesh: one plain linear-elastic
 solve (assembly, the MUMPS factorization of K without Schur complement: (a), one
@@ -32,11 +32,12 @@ A = 0.005  # the Hertz meshes' aimed contact half-width (m), bench/case.py's A_M
 # name: (mesh, build keywords). Contact DOFs follow h_contact and zone_factor (the
 # candidate zone), the size mostly h_far and refine.
 CASES = {
-    "2d_15k_c100": ("hertz2d", {"refine": 1, "zone_factor": 1.25, "h_contact": A / 5}),
+    "2d_20k_c100": ("hertz2d", {"refine": 1, "zone_factor": 1.25, "h_contact": A / 5,
+                                "h_far": 0.05 / 8}),
     "2d_50k_c800": ("hertz2d", {"refine": 2}),
     "2d_200k_c1600": ("hertz2d", {"refine": 3}),
     "2d_200k_c4000": ("hertz2d", {"refine": 3, "zone_factor": 6.25}),
-    "3d_6k_c100": ("hertz3d", {"refine": 0, "zone_factor": 1.0}),
+    "3d_11k_c160": ("hertz3d", {"refine": 0, "zone_factor": 1.0, "h_far": 0.014}),
     "3d_12k_c700": ("hertz3d", {"refine": 0}),
     "3d_60k_c2500": ("hertz3d", {"refine": 1}),
     "3d_120k_c4000": ("hertz3d", {"refine": 1, "zone_factor": 3.25, "h_far": 0.015}),
