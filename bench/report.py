@@ -162,9 +162,11 @@ def markdown(res: dict) -> str:
         "(the factorization with the Schur complement on the contact DOFs, its extraction "
         "and dense inverse) and W = B F* Bᵀ; (c) one load increment after set-up (median of "
         "increments 2–4 of a ramp of the approach to a²/R, no output written); (d) one "
-        "back-substitution with the stored factor (median of 5); local solve: the kernel's "
+        "back-substitution with the stored factor (median of one before each increment and 5 "
+        "after them); local solve: the kernel's "
         "contact step alone inside (c). Peak memory: the process's peak resident set from "
-        "the start of each phase (linear solve; contact set-up and increments), meshing "
+        "the start of each phase (linear solve; contact set-up and increments), the freed "
+        "heap handed back before each, meshing "
         "excluded. Contact solve / linear solve: (set-up + first increment) over assembly + "
         "factorization + load + one back-substitution of the same mesh without contact "
         "(the method's limit is 1).",
