@@ -124,9 +124,43 @@ def _target_table(rows: list[dict]) -> list[str]:
                 "≥ 100k in 3D)."]
     out = ["| case | target | value | result |", "|---|---|---:|---|"]
     for r in rows:
-        verdict = "met" if r["met"] else f"**missed by {r['miss_pct']:.0f}%**"
+        verdict = "met" if r["met"] else f"**missed by {r['miss_pct']:.1f}%**"
         note = f" ({r['note']})" if r["note"] else ""
         out.append(f"| {r['case']} | {r['target']} | {r['value']:.2f} | {verdict}{note} |")
+    return out
+
+
+def _why(rows: list[dict], cases: list[dict]) -> list[str]:
+    """Each miss split into its parts, from the same case's numbers."""
+    by_name = {c["name"]: c for c in cases}
+    out = []
+    for r in rows:
+        if r["met"]:
+            continue
+        c = by_name[r["case"]]
+        lin, con = c["linear"], c["contact"]
+        if r["target"].startswith("(b)"):
+            out.append(
+                f"* {c['name']}, (b)/(a) = {r['value']:.2f}: the factorization with the Schur "
+                f"complement took {con['factorization_s']:.1f} s ({con['mumps_ordering']}, "
+                f"{con['factor_entries'] / 1e6:.1f}M entries) against the plain one's "
+                f"{lin['factorization_s']:.1f} s ({lin['mumps_ordering']}, "
+                f"{lin['factor_entries'] / 1e6:.1f}M entries); on top of it the Schur "
+                f"complement's extraction {con['schur_s']:.1f} s, its dense inverse "
+                f"{con['inverse_s']:.1f} s (n_c = {con['contact_dofs']:,}) and W "
+                f"{con['delassus_s']:.2f} s.")
+        elif r["target"].startswith("(c)"):
+            rest = c["increment_s"] - 2 * c["backsolve_s"] - c["contact_solve_s"]
+            out.append(
+                f"* {c['name']}, (c)/(d) = {r['value']:.2f}: an increment is two "
+                f"back-substitutions ({2 * c['backsolve_s'] * 1e3:.0f} ms), the local contact "
+                f"solve ({c['contact_solve_s'] * 1e3:.0f} ms) and the rest (load assembly, "
+                f"gathers, write-back: {rest * 1e3:.0f} ms by difference"
+                + (", i.e. within the timings' noise" if rest < 0 else "") + ").")
+        else:
+            out.append(f"* {c['name']}, peak memory ratio {r['value']:.2f}: contact phase "
+                       f"{c['contact_peak_mb']:.0f} MB against {c['factorization_peak_mb']:.0f} MB"
+                       f"; dense F* and W {con['dense_mb']:.0f} MB.")
     return out
 
 
@@ -184,6 +218,9 @@ def markdown(res: dict) -> str:
         *_target_table(res.get("targets", [])),
         "",
     ]
+    why = _why(res.get("targets", []), res["cases"])
+    if why:
+        lines += ["Where each miss comes from (same run):", "", *why, ""]
     if res.get("notes"):
         lines += ["## Notes", "", *res["notes"], ""]
     failed = [c for c in res["cases"] if "error" in c]

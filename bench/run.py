@@ -127,7 +127,14 @@ def main(argv=None):
     ap.add_argument("--peers", action="store_true", help="also run bench/peers.py")
     ap.add_argument("--out", type=Path, default=HERE,
                     help="folder for RESULTS.md and results.json (default bench/)")
+    ap.add_argument("--rewrite", action="store_true",
+                    help="rewrite RESULTS.md from the results.json in --out (no run)")
     args = ap.parse_args(argv)
+    if args.rewrite:
+        results = json.loads((args.out / "results.json").read_text())
+        results["targets"] = report.targets(results["cases"])
+        (args.out / "RESULTS.md").write_text(report.markdown(results))
+        return
     names = args.cases or (FULL if args.full else DEFAULT)
     t0 = time.perf_counter()
     results = {"command": " ".join(["bench/run.py"] + (argv if argv is not None
