@@ -164,6 +164,14 @@ def _why(rows: list[dict], cases: list[dict]) -> list[str]:
     return out
 
 
+def _package_version(res: dict, key: str) -> str:
+    """The Debian version of the first loaded library whose file name holds ``key``."""
+    for lib in res.get("libraries", []):
+        if key in lib["path"].rsplit("/", 1)[-1] and lib["package"]:
+            return lib["package"].split()[-1]
+    return "?"
+
+
 def markdown(res: dict) -> str:
     m, v = res["machine"], res.get("versions", {})
     fc = res["flexcontact"]
@@ -182,7 +190,8 @@ def markdown(res: dict) -> str:
         f"{m['memory_gb']} GB",
         f"* flexcontact {v.get('flexcontact', '?')}, commit `{fc['commit'][:12]}`"
         + (" (with uncommitted changes)" if fc["dirty"] else ""),
-        f"* DOLFINx {v.get('dolfinx', '?')}, PETSc {v.get('petsc', '?')}, "
+        f"* DOLFINx {v.get('dolfinx', '?')}, PETSc {v.get('petsc', '?')}, MUMPS "
+        f"{_package_version(res, 'mumps')}, OpenBLAS/BLAS {_package_version(res, 'blas')}, "
         f"petsc4py {v.get('petsc4py', '?')}, Python {v.get('python', '?')}",
         "* Libraries loaded by the cases (MUMPS, METIS, PETSc, BLAS/LAPACK):",
         libs,
