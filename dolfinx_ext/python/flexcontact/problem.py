@@ -237,7 +237,10 @@ class ContactProblem:
         out, failure = None, None
         if root:
             try:
+                t1 = time.perf_counter()
                 out = self.contact.step(upc)  # the increment's one crossing into the kernel
+                # the local contact solve alone, for bench/ (the rest is sparse work)
+                self.timings["last_contact_step_s"] = time.perf_counter() - t1
                 q = out["local_q"]
             except ConvergenceError as e:
                 failure = (f"increment {number}: {e}", dict(getattr(e, "report", {})))

@@ -1,0 +1,239 @@
+"""Ratios, the targets of issue 18 (item 2) and bench/RESULTS.md from the cases of one run."""
+from __future__ import annotations
+
+LARGE_DOFS = {2: 200_000, 3: 100_000}  # the targets hold on meshes at least this large
+TARGET_CONTACT_DOFS = 4_500            # "(b)/(a) ≤ 1 up to 4,000 contact DOFs" (the ~4k sets)
+STEP_3D_DOFS = 300_000                 # "(c)/(d) ≤ 3 in 3D with 1,000 pairs at ≥ 300k DOFs"
+
+
+def derive(case: dict) -> dict:
+    """Add (a)–(d) and their ratios to a case that ran."""
+    if "error" in case:
+        return case
+    lin, con = case["linear"], case["contact"]
+    a, b = lin["factorization_s"], con["fstar_w_s"]
+    c, d = con["increment_s"], con["backsolve_s"]
+    whole = con["setup_s"] + con["first_increment_s"]
+    case.update({
+        "contact_dofs": con["contact_dofs"], "pairs": con["pairs"],
+        "factorization_s": a, "fstar_w_s": b, "increment_s": c, "backsolve_s": d,
+        "contact_solve_s": con["contact_solve_s"],
+        "factorization_peak_mb": lin["peak_mb"], "contact_peak_mb": con["peak_mb"],
+        "fstar_w_over_factorization": b / a,
+        "step_over_backsolve": c / d,
+        "contact_solve_over_backsolve": con["contact_solve_s"] / d,
+        "memory_over_factorization": con["peak_mb"] / lin["peak_mb"],
+        "contact_solve_total_s": whole,
+        "linear_solve_s": lin["solve_s"],
+        "contact_over_linear_solve": whole / lin["solve_s"],
+    })
+    return case
+
+
+def one_line(c: dict) -> str:
+    if "error" in c:
+        return f"{c['name']}: {c['error']}"
+    return (f"{c['dofs']:,} DOFs, {c['contact_dofs']:,} contact DOFs: "
+            f"(a) {c['factorization_s']:.2f} s (b) {c['fstar_w_s']:.2f} s (c) {c['increment_s'] * 1e3:.1f} ms (d) "
+            f"{c['backsolve_s'] * 1e3:.1f} ms | b/a {c['fstar_w_over_factorization']:.2f} "
+            f"c/d {c['step_over_backsolve']:.2f} memory {c['memory_over_factorization']:.2f} "
+            f"whole/linear {c['contact_over_linear_solve']:.2f}")
+
+
+def _large(c: dict) -> bool:
+    return "error" not in c and c["dofs"] >= LARGE_DOFS[c["dim"]]
+
+
+def targets(cases: list[dict]) -> list[dict]:
+    """Each target on each large case: the value, the limit, met or by how much it misses."""
+    rows = []
+
+    def check(c, what, key, limit, note=""):
+        v = c[key]
+        rows.append({"case": c["name"], "target": what, "value": v, "limit": limit,
+                     "met": v <= limit, "miss_pct": max(0.0, 100 * (v / limit - 1)),
+                     "note": note})
+
+    for c in filter(_large, cases):
+        if c["contact_dofs"] <= TARGET_CONTACT_DOFS:
+            check(c, "(b)/(a) ≤ 1", "fstar_w_over_factorization", 1.0)
+        if c["dim"] == 2:
+            check(c, "(c)/(d) ≤ 2 (2D)", "step_over_backsolve", 2.0)
+        elif c["dofs"] >= STEP_3D_DOFS:
+            check(c, "(c)/(d) ≤ 3 (3D, ≥ 300k DOFs)", "step_over_backsolve", 3.0)
+        else:
+            check(c, "(c)/(d) ≤ 3 (3D)", "step_over_backsolve", 3.0,
+                  "indicative: the target is set at ≥ 300k DOFs (--full)")
+        check(c, "peak memory ≤ 2× factorization", "memory_over_factorization", 2.0)
+    return rows
+
+
+def _f(v, digits=2):
+    return "—" if v is None else f"{v:.{digits}f}"
+
+
+def _case_table(cases: list[dict]) -> list[str]:
+    out = ["| case | DOFs | contact DOFs | pairs | (a) factorization s | (b) F* + W s | "
+           "(c) increment ms | (d) back-subst. ms | local solve ms | (b)/(a) | (c)/(d) | "
+           "local/(d) | peak MB factorization / contact | memory ratio | "
+           "contact solve / linear solve |",
+           "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for c in cases:
+        if "error" in c:
+            out.append(f"| {c['name']} | failed: {c['error']} |" + " |" * 13)
+            continue
+        out.append(
+            f"| {c['name']} | {c['dofs']:,} | {c['contact_dofs']:,} | {c['pairs']:,} | "
+            f"{_f(c['factorization_s'])} | {_f(c['fstar_w_s'])} | {_f(c['increment_s'] * 1e3, 1)}"
+            f" | {_f(c['backsolve_s'] * 1e3, 1)} | {_f(c['contact_solve_s'] * 1e3, 2)} | "
+            f"{_f(c['fstar_w_over_factorization'])} | {_f(c['step_over_backsolve'])} | "
+            f"{_f(c['contact_solve_over_backsolve'])} | {c['factorization_peak_mb']:.0f} / "
+            f"{c['contact_peak_mb']:.0f} | {_f(c['memory_over_factorization'])} | "
+            f"{_f(c['contact_over_linear_solve'])} |")
+    return out
+
+
+def _split_table(cases: list[dict]) -> list[str]:
+    out = ["| case | ordering plain / Schur | plain factor entries | Schur factor entries | "
+           "factorization with Schur s | Schur extraction s | dense inverse s | W s | "
+           "set-up s | first increment s | (c) − 2(d) − local solve ms | linear solve s | "
+           "local solver (iterations) | case wall / CPU s | load average |",
+           "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|"]
+    for c in cases:
+        if "error" in c:
+            continue
+        lin, con = c["linear"], c["contact"]
+        last = con["increments"][-1]
+        out.append(
+            f"| {c['name']} | {lin['mumps_ordering']} / {con['mumps_ordering']} | "
+            f"{lin['factor_entries'] / 1e6:.1f}M | {con['factor_entries'] / 1e6:.1f}M | "
+            f"{_f(con['factorization_s'])} | {_f(con['schur_s'])} | {_f(con['inverse_s'])} | "
+            f"{_f(con['delassus_s'], 3)} | {_f(con['setup_s'])} | "
+            f"{_f(con['first_increment_s'])} | "
+            f"{_f((c['increment_s'] - 2 * c['backsolve_s'] - c['contact_solve_s']) * 1e3, 1)} | "
+            f"{_f(lin['solve_s'])} | "
+            f"{last['solver']} ({last['iterations']}) | {c['wall_s']:.0f} / "
+            f"{_f(c.get('process_cpu_s'), 0)} | "
+            + " → ".join(f"{x:.1f}" for x in c.get("load_average", [])) + " |")
+    return out
+
+
+def _target_table(rows: list[dict]) -> list[str]:
+    if not rows:
+        return ["No case of this run is large enough for the targets (≥ 200k DOFs in 2D, "
+                "≥ 100k in 3D)."]
+    out = ["| case | target | value | result |", "|---|---|---:|---|"]
+    for r in rows:
+        verdict = "met" if r["met"] else f"**missed by {r['miss_pct']:.1f}%**"
+        note = f" ({r['note']})" if r["note"] else ""
+        out.append(f"| {r['case']} | {r['target']} | {r['value']:.2f} | {verdict}{note} |")
+    return out
+
+
+def _why(rows: list[dict], cases: list[dict]) -> list[str]:
+    """Each miss split into its parts, from the same case's numbers."""
+    by_name = {c["name"]: c for c in cases}
+    out = []
+    for r in rows:
+        if r["met"]:
+            continue
+        c = by_name[r["case"]]
+        lin, con = c["linear"], c["contact"]
+        if r["target"].startswith("(b)"):
+            out.append(
+                f"* {c['name']}, (b)/(a) = {r['value']:.2f}: the factorization with the Schur "
+                f"complement took {con['factorization_s']:.1f} s ({con['mumps_ordering']}, "
+                f"{con['factor_entries'] / 1e6:.1f}M entries) against the plain one's "
+                f"{lin['factorization_s']:.1f} s ({lin['mumps_ordering']}, "
+                f"{lin['factor_entries'] / 1e6:.1f}M entries); on top of it the Schur "
+                f"complement's extraction {con['schur_s']:.1f} s, its dense inverse "
+                f"{con['inverse_s']:.1f} s (n_c = {con['contact_dofs']:,}) and W "
+                f"{con['delassus_s']:.2f} s.")
+        elif r["target"].startswith("(c)"):
+            rest = c["increment_s"] - 2 * c["backsolve_s"] - c["contact_solve_s"]
+            out.append(
+                f"* {c['name']}, (c)/(d) = {r['value']:.2f}: an increment is two "
+                f"back-substitutions ({2 * c['backsolve_s'] * 1e3:.0f} ms), the local contact "
+                f"solve ({c['contact_solve_s'] * 1e3:.0f} ms) and the rest (load assembly, "
+                f"gathers, write-back: {rest * 1e3:.0f} ms by difference"
+                + (", i.e. within the timings' noise" if rest < 0 else "") + ").")
+        else:
+            out.append(f"* {c['name']}, peak memory ratio {r['value']:.2f}: contact phase "
+                       f"{c['contact_peak_mb']:.0f} MB against {c['factorization_peak_mb']:.0f} MB"
+                       f"; dense F* and W {con['dense_mb']:.0f} MB.")
+    return out
+
+
+def _package_version(res: dict, key: str) -> str:
+    """The Debian version of the first loaded library whose file name holds ``key``."""
+    for lib in res.get("libraries", []):
+        if key in lib["path"].rsplit("/", 1)[-1] and lib["package"]:
+            return lib["package"].split()[-1]
+    return "?"
+
+
+def markdown(res: dict) -> str:
+    m, v = res["machine"], res.get("versions", {})
+    fc = res["flexcontact"]
+    libs = "\n".join(f"  - `{x['path']}`" + (f" ({x['package']})" if x["package"] else "")
+                     for x in res.get("libraries", []))
+    lines = [
+        "# Bench results",
+        "",
+        f"Written by `{res['command']}` (bench/README.md), started {res['started_utc']} UTC, "
+        f"{res['total_s'] / 60:.1f} min in all. **Every ratio below comes from this one run** "
+        "on a shared machine: the times carry its noise (load average "
+        f"{m['load_average_at_start'][0]:.1f} at the start); the ratios of the same case are "
+        "measured minutes apart in one process.",
+        "",
+        f"* Machine: {m['cpu']}, {m['cores']} cores ({m['usable_cores']} usable), "
+        f"{m['memory_gb']} GB",
+        f"* flexcontact {v.get('flexcontact', '?')}, commit `{fc['commit'][:12]}`"
+        + (" (with uncommitted changes)" if fc["dirty"] else ""),
+        f"* DOLFINx {v.get('dolfinx', '?')}, PETSc {v.get('petsc', '?')}, MUMPS "
+        f"{_package_version(res, 'mumps')}, OpenBLAS/BLAS {_package_version(res, 'blas')}, "
+        f"petsc4py {v.get('petsc4py', '?')}, Python {v.get('python', '?')}",
+        "* Libraries loaded by the cases (MUMPS, METIS, PETSc, BLAS/LAPACK):",
+        libs,
+        "",
+        "## Definitions",
+        "",
+        "Each case is one process on a Hertz mesh (`meshes/hertz2d.py` plane strain, "
+        "`meshes/hertz3d.py` quarter model; steel on steel, μ = 0.3), one serial rank. "
+        "(a) one plain MUMPS factorization of K (analysis with flexcontact's ordering, "
+        "`ordering=\"auto\"`, and numerical factorization, no Schur complement); (b) F* "
+        "(the factorization with the Schur complement on the contact DOFs, its extraction "
+        "and dense inverse) and W = B F* Bᵀ; (c) one load increment after set-up (median of "
+        "increments 2–4 of a ramp of the approach to a²/R, no output written); (d) one "
+        "back-substitution with the stored factor (median of one before each increment and 5 "
+        "after them); local solve: the kernel's "
+        "contact step alone inside (c). Peak memory: the process's peak resident set from "
+        "the start of each phase (linear solve; contact set-up and increments), the freed "
+        "heap handed back before each, meshing "
+        "excluded. Contact solve / linear solve: (set-up + first increment) over assembly + "
+        "factorization + load + one back-substitution of the same mesh without contact "
+        "(the method's limit is 1).",
+        "",
+        "## Cases",
+        "",
+        *_case_table(res["cases"]),
+        "",
+        "Where the time goes:",
+        "",
+        *_split_table(res["cases"]),
+        "",
+        "## Targets (issue 18, item 2) on the large meshes",
+        "",
+        *_target_table(res.get("targets", [])),
+        "",
+    ]
+    why = _why(res.get("targets", []), res["cases"])
+    if why:
+        lines += ["Where each miss comes from (same run):", "", *why, ""]
+    if res.get("notes"):
+        lines += ["## Notes", "", *res["notes"], ""]
+    failed = [c for c in res["cases"] if "error" in c]
+    for c in failed:
+        lines += [f"Case {c['name']} failed ({c['error']}):", "", "```",
+                  c.get("log_tail", ""), "```", ""]
+    return "\n".join(lines)
