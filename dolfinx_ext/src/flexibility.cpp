@@ -187,7 +187,9 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
     err.check(MatCholeskyFactorSymbolic(F.m, K, nullptr, &info), "MatCholeskyFactorSymbolic");
     out.analysis_s = MPI_Wtime() - ta;
     check_mumps(err, F.m, "analysis");
-    if (icntl7 != 7)
+    PetscInt used7 = -1;
+    err.check(MatMumpsGetInfog(F.m, 7, &used7), "MatMumpsGetInfog(7)");
+    if (icntl7 != 7 and not(icntl7 == 0 and used7 == 0)) // AMD asked and already used
     {
       // PETSc cannot pass ICNTL(7) = 1 with PERM_IN: redo the analysis with the requested
       // ordering on the same MUMPS instance.
