@@ -27,13 +27,13 @@ void flexcontact::bind_petsc(py::module& m)
   m.def(
       "flexibility",
       [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
-         const std::string& method, const std::string& ordering)
+         const std::string& method, const std::string& ordering, bool per_body)
       {
         std::span<const std::int64_t> dofs(contact_dofs.data(), contact_dofs.size());
         Flexibility r;
         {
           py::gil_scoped_release release;
-          r = flexibility(K, dofs, method, ordering);
+          r = flexibility(K, dofs, method, ordering, per_body);
         }
         py::dict info;
         info["method"] = r.method;
@@ -48,15 +48,19 @@ void flexcontact::bind_petsc(py::module& m)
         info["mumps_ordering"] = r.mumps_ordering;
         info["ordering_fallback"] = r.ordering_fallback;
         info["ordering_s"] = r.ordering_s;
+        info["analysis_s"] = r.analysis_s;
         info["factor_entries"] = r.factor_entries;
         info["factor_flops"] = r.factor_flops;
         info["factor_memory_mb"] = r.factor_memory_mb;
+        info["n_blocks"] = r.n_blocks;
+        info["block_sizes"] = r.block_sizes;
+        info["blocks_s"] = r.blocks_s;
         py::object factor = py::cast(r.factor, py::return_value_policy::take_ownership);
         py::array_t<double> F = py::cast(r.F);
         return py::make_tuple(F, factor, info);
       },
       py::arg("K"), py::arg("contact_dofs"), py::arg("method") = "schur",
-      py::arg("ordering") = "auto",
+      py::arg("ordering") = "auto", py::arg("per_body") = true,
       R"(Flexibility F* = (K^-1)_cc on the contact DOFs from one MUMPS Cholesky factorization.
 
 Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); contact_dofs
@@ -70,6 +74,10 @@ ordering: MUMPS's fill-reducing ordering, "auto" (the default: "metis" for K of 
 handed to MUMPS), "mumps" (MUMPS's automatic choice; Debian's MUMPS has AMD, AMF, PORD,
 QAMD), or one of "amd", "amf", "pord", "qamd"; on several ranks MUMPS's automatic choice is
 used (info["ordering"] tells the one asked of MUMPS, "auto" resolved).
+per_body (default True): the contact DOFs that K's graph connects form a block (one per body
+touching contact); F* is block-diagonal by them and only the blocks are computed ("schur":
+each block of K*_cc inverted on its own; "inverse_entries": only entries within blocks asked
+of MUMPS). False: one block of all contact DOFs (the same F* up to rounding).
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
 factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; info:
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
@@ -77,8 +85,10 @@ workspace), factorization_s,
 schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s, ordering
 (requested), mumps_ordering (used, INFOG(7)), ordering_fallback (why "auto" kept MUMPS's own
 ordering: this PETSc's MUMPS factor cannot take ours; empty otherwise), ordering_s (METIS and the redone analysis,
-part of factorization_s), factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
-factor_memory_mb (INFOG(22)).
+part of factorization_s), analysis_s (PETSc's own MUMPS analysis, part of factorization_s),
+factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
+factor_memory_mb (INFOG(22)), n_blocks, block_sizes (contact DOFs per block, rank 0),
+blocks_s (finding the blocks).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
 

@@ -1,6 +1,7 @@
 // Copyright flexcontact developers. MIT licence.
 
 #include "flexibility.h"
+#include "contact_blocks.h"
 #include "ordering.h"
 #include "petsc_error.h"
 
@@ -152,7 +153,7 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
   PetscInt icntl14 = 0; // 0: MUMPS's default
   PetscInt N = 0;
   err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
-  const int icntl7 = mumps_icntl7(ordering);
+  int icntl7 = mumps_icntl7(ordering);
   std::vector<int> perm_in;
   double t0 = MPI_Wtime();
   if (icntl7 == 1)
@@ -167,6 +168,10 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
     err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
     if (icntl14 > 0)
       err.check(MatMumpsSetIcntl(F.m, 14, icntl14), "MatMumpsSetIcntl(14)");
+    // PETSc's own analysis is redone below with the requested ordering: let it use the
+    // cheapest one (AMD) rather than MUMPS's automatic choice (PORD or AMF, slow in 3D).
+    if (icntl7 != 7)
+      err.check(MatMumpsSetIcntl(F.m, 7, 0), "MatMumpsSetIcntl(7)");
     if (schur)
     {
       MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
@@ -178,12 +183,16 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
     }
     MatFactorInfo info;
     err.check(MatFactorInfoInitialize(&info), "MatFactorInfoInitialize");
+    double ta = MPI_Wtime();
     err.check(MatCholeskyFactorSymbolic(F.m, K, nullptr, &info), "MatCholeskyFactorSymbolic");
+    out.analysis_s = MPI_Wtime() - ta;
     check_mumps(err, F.m, "analysis");
-    if (icntl7 != 7)
+    PetscInt used7 = -1;
+    err.check(MatMumpsGetInfog(F.m, 7, &used7), "MatMumpsGetInfog(7)");
+    if (icntl7 != 7 and not(icntl7 == 0 and used7 == 0)) // AMD asked and already used
     {
-      // PETSc's analysis used MUMPS's automatic choice (PETSc cannot pass ICNTL(7) = 1 and
-      // resets ICNTL(7) before it): redo it with the requested ordering.
+      // PETSc cannot pass ICNTL(7) = 1 with PERM_IN: redo the analysis with the requested
+      // ordering on the same MUMPS instance.
       double t1 = MPI_Wtime();
       try
       {
@@ -191,11 +200,15 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
       }
       catch (const MumpsLayoutError& e)
       {
-        // "auto" promises a factorization, not METIS: keep PETSc's own analysis (untouched).
+        // "auto" promises a factorization, not METIS: start again with a fresh factor and
+        // MUMPS's own choice (PETSc's analysis above used AMD).
         if (not out.ordering_auto)
           throw;
         out.ordering = "mumps";
         out.ordering_fallback = e.what();
+        icntl7 = 7;
+        out.ordering_s += MPI_Wtime() - t1;
+        continue;
       }
       out.ordering_s += MPI_Wtime() - t1;
     }
@@ -222,15 +235,22 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
   }
 }
 
-/// @brief F* = (K*_cc)⁻¹ on rank 0 from the Schur complement of the factor.
+/// @brief F* = (K*_cc)⁻¹ on rank 0 from the Schur complement of the factor, block by block
+/// (`blocks`: rank 0's positions of each block's contact DOFs).
 Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
-                                 int n_c, double& schur_s, double& inverse_s)
+                                 int n_c, const std::vector<std::vector<int>>& blocks,
+                                 double& schur_s, double& inverse_s)
 {
   double t0 = MPI_Wtime();
   OwnedMat S;
   MatFactorSchurStatus status;
   err.check(MatFactorCreateSchurComplement(F, &S.m, &status), "MatFactorCreateSchurComplement");
-  Eigen::MatrixXd Kcc;
+  double t1 = MPI_Wtime();
+  schur_s = t1 - t0;
+
+  Eigen::MatrixXd Fs;
+  bool singular = false;
+  std::string what;
   if (rank == 0)
   {
     PetscInt m = 0, n = 0, lda = 0;
@@ -241,38 +261,16 @@ Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, 
     err.check(MatDenseGetLDA(S.m, &lda), "MatDenseGetLDA");
     const PetscScalar* a = nullptr;
     err.check(MatDenseGetArrayRead(S.m, &a), "MatDenseGetArrayRead");
-    Kcc.resize(n_c, n_c);
-    for (int j = 0; j < n_c; ++j)
-      for (int i = 0; i < n_c; ++i)
-        Kcc(i, j) = a[i + static_cast<std::size_t>(j) * lda];
-    err.check(MatDenseRestoreArrayRead(S.m, &a), "MatDenseRestoreArrayRead");
-  }
-  double t1 = MPI_Wtime();
-  schur_s = t1 - t0;
-
-  Eigen::MatrixXd Fs;
-  bool singular = false;
-  std::string what;
-  if (rank == 0)
-  {
-    Eigen::MatrixXd Ks = 0.5 * (Kcc + Kcc.transpose());
-    Eigen::LLT<Eigen::MatrixXd> llt(Ks);
-    double rcond = llt.info() == Eigen::Success ? llt.rcond() : 0.0;
-    if (llt.info() != Eigen::Success or !(rcond > 1e3 * std::numeric_limits<double>::epsilon()))
+    try
+    {
+      Fs = blockwise_inverse(a, static_cast<std::size_t>(lda), blocks);
+    }
+    catch (const SingularStiffnessError& e)
     {
       singular = true;
-      std::ostringstream s;
-      s << "stiffness matrix is singular: the condensed stiffness K*_cc on the " << n_c
-        << " contact DOFs is not positive definite (reciprocal condition number "
-        << std::scientific << std::setprecision(2) << rcond
-        << "; a body has rigid-body modes that no Dirichlet condition removes)";
-      what = s.str();
+      what = e.what();
     }
-    else
-    {
-      Fs = llt.solve(Eigen::MatrixXd::Identity(n_c, n_c));
-      Fs = 0.5 * (Fs + Fs.transpose()).eval();
-    }
+    err.check(MatDenseRestoreArrayRead(S.m, &a), "MatDenseRestoreArrayRead");
   }
   throw_collective_if(comm, singular, what,
                       [](const std::string& w) { throw SingularStiffnessError(w); });
@@ -356,8 +354,12 @@ Eigen::MatrixXd multi_rhs_solve(PetscErrorScope& err, MPI_Comm comm, int rank, M
 /// many right-hand sides as rows of K, so Bt is N×N. In parallel PETSc reads the diagonal
 /// block of rank 0's part of the MPIAIJ, so rank 0 owns all N rows and all N columns of Bt and
 /// the other ranks own none. MUMPS overwrites Bt's values with the entries of K⁻¹.
+///
+/// Only the entries within a block (`labels`, rank 0's block of each contact DOF) are asked
+/// for: the others are zero (contact_blocks.h).
 Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
-                                 PetscInt N, const std::vector<PetscInt>& dofs)
+                                 PetscInt N, const std::vector<PetscInt>& dofs,
+                                 const std::vector<int>& labels)
 {
   const int n_c = static_cast<int>(dofs.size());
   // Rows of an AIJ matrix are set with sorted columns; pos[k] is the place of sorted[k] in dofs.
@@ -367,6 +369,20 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
   std::vector<PetscInt> sorted(n_c);
   for (int k = 0; k < n_c; ++k)
     sorted[k] = dofs[pos[k]];
+  // Per block, its DOFs in sorted order (the columns of its rows of Bt) and their places.
+  std::vector<std::vector<PetscInt>> block_cols;
+  std::vector<std::vector<int>> block_pos;
+  if (rank == 0)
+  {
+    const int n_blocks = n_c ? *std::max_element(labels.begin(), labels.end()) + 1 : 0;
+    block_cols.resize(n_blocks);
+    block_pos.resize(n_blocks);
+    for (int k = 0; k < n_c; ++k)
+    {
+      block_cols[labels[pos[k]]].push_back(sorted[k]);
+      block_pos[labels[pos[k]]].push_back(pos[k]);
+    }
+  }
 
   const PetscInt n_local = rank == 0 ? N : 0;
   OwnedMat Bt;
@@ -375,8 +391,8 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
   err.check(MatSetType(Bt.m, MATAIJ), "MatSetType(aij)");
   std::vector<PetscInt> nnz(n_local, 0);
   if (rank == 0)
-    for (PetscInt r : sorted)
-      nnz[r] = n_c;
+    for (int k = 0; k < n_c; ++k)
+      nnz[sorted[k]] = static_cast<PetscInt>(block_cols[labels[pos[k]]].size());
   err.check(MatSeqAIJSetPreallocation(Bt.m, 0, nnz.data()), "MatSeqAIJSetPreallocation");
   err.check(MatMPIAIJSetPreallocation(Bt.m, 0, nnz.data(), 0, nullptr),
             "MatMPIAIJSetPreallocation");
@@ -384,9 +400,13 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
   {
     // Non-zero placeholders: the pattern is what matters, and AIJ keeps it whatever the value.
     const std::vector<PetscScalar> ones(n_c, 1.0);
-    for (PetscInt r : sorted)
-      err.check(MatSetValues(Bt.m, 1, &r, n_c, sorted.data(), ones.data(), INSERT_VALUES),
+    for (int k = 0; k < n_c; ++k)
+    {
+      const std::vector<PetscInt>& cols = block_cols[labels[pos[k]]];
+      err.check(MatSetValues(Bt.m, 1, &sorted[k], static_cast<PetscInt>(cols.size()),
+                             cols.data(), ones.data(), INSERT_VALUES),
                 "MatSetValues");
+    }
   }
   err.check(MatAssemblyBegin(Bt.m, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   err.check(MatAssemblyEnd(Bt.m, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
@@ -418,10 +438,13 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
       const PetscInt* cols = nullptr;
       const PetscScalar* vals = nullptr;
       err.check(MatGetRow(Bt.m, sorted[k], &ncols, &cols, &vals), "MatGetRow");
-      if (ncols == n_c and std::equal(cols, cols + ncols, sorted.begin()))
+      const std::vector<PetscInt>& want = block_cols[labels[pos[k]]];
+      const std::vector<int>& place = block_pos[labels[pos[k]]];
+      if (static_cast<std::size_t>(ncols) == want.size()
+          and std::equal(cols, cols + ncols, want.begin()))
       {
-        for (int l = 0; l < n_c; ++l)
-          Fs(pos[l], pos[k]) = vals[l];
+        for (PetscInt l = 0; l < ncols; ++l)
+          Fs(place[l], pos[k]) = vals[l];
       }
       else
       {
@@ -439,7 +462,8 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
 } // namespace
 
 Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
-                                     const std::string& method, const std::string& ordering)
+                                     const std::string& method, const std::string& ordering,
+                                     bool per_body)
 {
   if (method != "schur" and method != "inverse_entries" and method != "matmatsolve")
     throw std::invalid_argument("unknown flexibility method '" + method
@@ -496,6 +520,16 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
 
+  double tb = MPI_Wtime();
+  const std::vector<int> labels = per_body ? contact_blocks(K, dofs)
+                                           : std::vector<int>(rank == 0 ? n_c : 0, 0);
+  const std::vector<std::vector<int>> blocks = block_members(labels);
+  out.blocks_s = MPI_Wtime() - tb;
+  out.n_blocks = static_cast<int>(blocks.size());
+  MPI_Bcast(&out.n_blocks, 1, MPI_INT, 0, comm);
+  for (const auto& b : blocks)
+    out.block_sizes.push_back(static_cast<int>(b.size()));
+
   if (n_c == 0)
   {
     double t0 = MPI_Wtime();
@@ -513,7 +547,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     F.m = factorize(err, K, &root_dofs, out.ordering, out);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
-    out.F = inverse_of_schur(err, comm, rank, F.m, n_c, out.schur_s, out.inverse_s);
+    out.F = inverse_of_schur(err, comm, rank, F.m, n_c, blocks, out.schur_s, out.inverse_s);
     out.factor = F.release();
   }
   else
@@ -524,17 +558,18 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     double t1 = MPI_Wtime();
-    out.F = used == "inverse_entries" ? selected_inverse(err, comm, rank, F.m, M, dofs)
+    out.F = used == "inverse_entries" ? selected_inverse(err, comm, rank, F.m, M, dofs, labels)
                                       : multi_rhs_solve(err, comm, rank, K, F.m, dofs);
     out.schur_s = MPI_Wtime() - t1;
     out.factor = F.release();
   }
 
-  double t[3] = {out.factorization_s, out.schur_s, out.inverse_s};
-  MPI_Allreduce(MPI_IN_PLACE, t, 3, MPI_DOUBLE, MPI_MAX, comm);
+  double t[4] = {out.factorization_s, out.schur_s, out.inverse_s, out.blocks_s};
+  MPI_Allreduce(MPI_IN_PLACE, t, 4, MPI_DOUBLE, MPI_MAX, comm);
   out.factorization_s = t[0];
   out.schur_s = t[1];
   out.inverse_s = t[2];
+  out.blocks_s = t[3];
   return out;
 }
 

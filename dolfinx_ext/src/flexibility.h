@@ -11,6 +11,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace flexcontact
 {
@@ -57,6 +58,10 @@ struct Flexibility
   bool ordering_auto = false;    ///< "auto" was asked: MUMPS's own choice if ours cannot be set
   std::string ordering_fallback; ///< why "auto" fell back to MUMPS's own ordering (else empty)
   double ordering_s = 0;         ///< METIS and the redone analysis (within factorization_s)
+  double analysis_s = 0;         ///< PETSc's own MUMPS analysis (within factorization_s)
+  int n_blocks = 0;              ///< blocks F* is block-diagonal by (bodies with contact DOFs)
+  std::vector<int> block_sizes;  ///< contact DOFs per block, in block order (rank 0)
+  double blocks_s = 0;           ///< finding the blocks (contact_blocks.h)
   std::int64_t factor_entries = 0; ///< entries in the factor, INFOG(29)
   double factor_flops = 0;       ///< flops of the elimination, RINFOG(3)
   int factor_memory_mb = 0;      ///< MUMPS memory of the factorization (all ranks), INFOG(22)
@@ -69,8 +74,15 @@ struct Flexibility
 ///
 /// Every method makes exactly one sparse factorization, and the returned factor is it.
 ///
+/// Per body (`per_body`, contact_blocks.h): the contact DOFs are split into the blocks that
+/// K's graph connects (one per body touching contact); F* is block-diagonal by them, with
+/// exact zeros between blocks, and only the blocks are computed: "schur" inverts each
+/// block of K*_cc on its own, "inverse_entries" asks MUMPS only for the entries within
+/// blocks. With `per_body` false all contact DOFs form one block (F* equal up to rounding).
+///
 /// * "schur": MUMPS computes the Schur complement K*_cc = K_cc − K_cr K_rr⁻¹ K_rc inside the
-///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ by a dense Cholesky. The
+///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ by LAPACK's dense Cholesky
+///   inverse (dpotrf, dpotri) of each block. The
 ///   returned factor is the same factorization (PETSc runs MUMPS's condensation and
 ///   expansion phases around the Schur solve, so MatSolve gives K⁻¹b). PETSc cannot solve
 ///   with a Schur factor in parallel, so with more than one rank "schur" is replaced by
@@ -89,12 +101,13 @@ struct Flexibility
 ///   "mumps" otherwise), "metis" (nested dissection of the nodal graph, the Schur variables
 ///   last), "mumps" (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd"; on several
 ///   ranks MUMPS's automatic choice is used
+/// @param per_body condense each block (body) on its own (default); false: one block
 /// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
 /// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)
 /// @throws MumpsError on a MUMPS failure, PetscError on a PETSc failure
 Flexibility flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
                         const std::string& method = "schur",
-                        const std::string& ordering = "auto");
+                        const std::string& ordering = "auto", bool per_body = true);
 
 /// @brief MUMPS's analysis only (serial): what the factorization of K with `ordering` and a
 /// Schur complement on `contact_dofs` (none if empty) would cost, without factorizing. In the
