@@ -9,7 +9,7 @@ codename=$(. /etc/os-release && echo "${VERSION_CODENAME:-unknown}")
 build="$here/build/$codename"
 
 packages=(
-  cmake g++ make pkg-config python3-dev libblas-dev python3-venv python3-setuptools
+  cmake g++ make pkg-config python3-dev libblas-dev liblapack-dev python3-venv python3-setuptools
   python3-dolfinx libdolfinx-dev petsc-dev python3-petsc4py python3-mpi4py openmpi-bin
   gmsh python3-gmsh libeigen3-dev pybind11-dev
   googletest libgtest-dev python3-pytest python3-scipy python3-matplotlib python3-tqdm
