@@ -29,8 +29,9 @@ from .tools import surface_nodes
 
 from .tags import (BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y,  # noqa: F401
                    UPPER)
-from . import bar_impact, block_on_base, hertz2d, hertz3d, oblique_impact, patch  # noqa: E402,F401
+from . import (bar_impact, block_on_base, hertz2d, hertz3d, oblique_impact, patch,  # noqa: E402,F401
+               two_cylinders)
 
 __all__ = ["BASE", "UPPER", "FIXED", "LOADED", "SYMMETRY_X", "SYMMETRY_Y", "MASTER", "SLAVE",
            "NAMES", "to_dolfinx", "surface_nodes", "bar_impact", "block_on_base", "hertz2d", "hertz3d",
-           "oblique_impact", "patch"]
+           "oblique_impact", "patch", "two_cylinders"]

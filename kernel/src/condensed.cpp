@@ -97,11 +97,48 @@ void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   Vector x0 = initial_gap(pairs, X_);
   IncrementalSolver solver(dim_, delassus(B, F_), mu, options_);
   solver.set_initial_gap(u_c_.size() ? Vector(B * u_c_ + x0) : x0);
+  if (!solver_.states().empty())
+    solver.set_warm_start(carried_force(pairs), carried_states(pairs));
   B_ = std::move(B);
   x0_ = std::move(x0);
   solver_ = std::move(solver);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
+}
+
+std::vector<int> CondensedContact::previous_pair_of(const std::vector<ContactPair>& pairs) const
+{
+  std::vector<int> of_slave(static_cast<std::size_t>(X_.rows()), -1);
+  for (std::size_t k = 0; k < pairs_.size(); ++k)
+    of_slave[static_cast<std::size_t>(pairs_[k].slave)] = static_cast<int>(k);
+  std::vector<int> previous(pairs.size(), -1);
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    previous[k] = of_slave[static_cast<std::size_t>(pairs[k].slave)];
+  return previous;
+}
+
+Vector CondensedContact::carried_force(const std::vector<ContactPair>& pairs) const
+{
+  // The slave node's force in global axes, T_oldᵀ λ_old, seen in the new frame.
+  const std::vector<int> previous = previous_pair_of(pairs);
+  const Vector& old = solver_.force();
+  Vector lambda = Vector::Zero(static_cast<Eigen::Index>(pairs.size()) * dim_);
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (const int j = previous[k]; j >= 0)
+      lambda.segment(static_cast<Eigen::Index>(k) * dim_, dim_)
+          = pairs[k].frame * (pairs_[j].frame.transpose() * old.segment(j * dim_, dim_));
+  return lambda;
+}
+
+std::vector<PairState> CondensedContact::carried_states(
+    const std::vector<ContactPair>& pairs) const
+{
+  const std::vector<int> previous = previous_pair_of(pairs);
+  std::vector<PairState> states(pairs.size(), PairState::open);
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (previous[k] >= 0)
+      states[k] = solver_.states()[static_cast<std::size_t>(previous[k])];
+  return states;
 }
 
 std::string CondensedContact::held_and_penetrating(const Vector& q) const

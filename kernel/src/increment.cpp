@@ -99,6 +99,21 @@ void IncrementalSolver::set_delassus(Matrix W)
   W_ = std::move(W);
 }
 
+void IncrementalSolver::set_warm_start(Vector lambda, std::vector<PairState> states)
+{
+  const std::string who = "flexcontact: IncrementalSolver::set_warm_start: ";
+  if (lambda.size() != x_.size())
+    throw std::invalid_argument(who + "lambda has size " + std::to_string(lambda.size())
+                                + ", expected " + std::to_string(x_.size()));
+  if (states.size() != static_cast<std::size_t>(pairs()))
+    throw std::invalid_argument(who + "states has " + std::to_string(states.size())
+                                + " entries, expected " + std::to_string(pairs()));
+  if (!lambda.allFinite())
+    throw std::invalid_argument(who + "lambda is not finite");
+  lambda_ = std::move(lambda);
+  states_ = std::move(states);
+}
+
 Vector IncrementalSolver::local_q(const Eigen::Ref<const Vector>& q_total) const
 {
   // The slip of this increment is x_t − x_t,prev: remove the previous tangential gap.

@@ -176,9 +176,10 @@ TEST(Condensed, NewPairsRebuildFromStoredFlexibility)
 {
   const Matrix F = random_spd(4, 10.0, 3);
   CondensedContact c(2, F, X2, one_pair(), vec({0.3}));
-  c.step(vec({0.001, -0.2, 0.0, 0.0}));
+  const CondensedStep s = c.step(vec({0.001, -0.2, 0.0, 0.0}));
   const Vector q = c.last_q();
   const Vector q_before = c.local_q(q);
+  ASSERT_GT(s.lambda[0], 0.0); // closed: there is a history to carry over
 
   // The same pairs again: the slip origin is the current gap, so nothing changes.
   c.set_pairs(one_pair(), vec({0.3}));
@@ -192,7 +193,20 @@ TEST(Condensed, NewPairsRebuildFromStoredFlexibility)
   EXPECT_LT((c.x0() - initial_gap(tilted, X2)).norm(), 1e-15);
   EXPECT_LT((c.W() - B * F * B.transpose()).norm(), 1e-14 * F.norm());
   EXPECT_EQ(c.mu()[0], 0.5);
-  EXPECT_EQ(c.solver().states().size(), 0u); // history reset
+  // The slave node keeps its state, and its force in global axes as the warm start.
+  ASSERT_EQ(c.solver().states().size(), 1u);
+  EXPECT_EQ(c.solver().states()[0], s.states[0]);
+  const Vector f_before = one_pair()[0].frame.transpose() * s.lambda;
+  const Vector f_after = tilted[0].frame.transpose() * c.solver().force();
+  EXPECT_LT((f_after - f_before).norm(), 1e-14 * f_before.norm());
+
+  // A pair of another slave node starts from nothing.
+  CondensedContact other(2, F, X2, one_pair(), vec({0.3}));
+  other.step(vec({0.001, -0.2, 0.0, 0.0}));
+  other.set_pairs({make_pair(1, {0}, {1.0}, vec({0.0, -1.0}))}, vec({0.3}));
+  ASSERT_EQ(other.solver().states().size(), 1u);
+  EXPECT_EQ(other.solver().states()[0], PairState::open);
+  EXPECT_EQ(other.solver().force().norm(), 0.0);
 
   // Bad pairs leave the object as it was.
   EXPECT_CONTAINS(message_of([&] { c.set_pairs({make_pair(5, {1}, {1.0}, vec({0.0, 1.0}))},

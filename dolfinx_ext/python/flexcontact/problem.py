@@ -160,10 +160,17 @@ class ContactProblem:
         3D, "mumps" in 2D), "metis" (METIS nested dissection handed to MUMPS), "mumps"
         (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd" (names.Ordering;
         bench/ordering.py compares them).
+    repair_pairs : True (default): node–surface, surface–surface and rigid-target pairs
+        are re-made before every increment at the current positions; a slave node that
+        keeps a pair keeps its λ and state as the next increment's warm start, and its slip
+        is measured from where it now is on the master. False keeps the pairs of the
+        reference positions (each slave node tied to a fixed master point; for comparisons
+        and small slips).
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
-    Node–surface and rigid-target pairs are re-made before every increment (``repair``);
+    Node–surface and rigid-target pairs are re-made before every increment (``repair``)
+    unless ``repair_pairs`` is False;
     ``factorizations`` counts the sparse factorizations (one) and ``pairings`` how often
     the pairs were made.
     """
@@ -172,8 +179,11 @@ class ContactProblem:
                  contact: Union[ContactInterface, Sequence[ContactInterface]], *,
                  bodies: Optional[tuple[MeshTags, dict[str, int]]] = None,
                  stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
-                 flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto"):
+                 flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto",
+                 repair_pairs: bool = True):
         check_flexibility_method(flexibility)
+        if not isinstance(repair_pairs, (bool, np.bool_)):
+            raise ValueError(f"repair_pairs={repair_pairs!r}; it must be True or False")
         check_ordering(ordering)
         if solver is not None:
             check_chain(solver.chain)
@@ -205,7 +215,8 @@ class ContactProblem:
         self.pairs, self.mu, self.m = pair_interfaces(self.V, self.interfaces, self.comm)
         self.timings["pairing_s"] = time.perf_counter() - t0
         # Node–surface and rigid-target pairs follow the bodies: re-made before each increment.
-        self.repairing = any(i.pairing_used != "node_to_node" for i in self.interfaces)
+        self.repairing = bool(repair_pairs) and any(i.pairing_used != "node_to_node"
+                                                    for i in self.interfaces)
         self.pairings = 1
         self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
                                          self.comm, self.options, self.flexibility_method,

@@ -67,9 +67,13 @@ public:
   void set_flexibility(Matrix Fstar);
 
   /// @brief Replace the pairs (re-pairing as bodies slide) and rebuild B, x0, W from the
-  /// stored F*. The history is reset: λ = 0, no states. Slip is measured from the new pairs'
-  /// gap at the contact displacement of the last increment, u_c = u_p,c + F* r_c (zero
-  /// before the first one), so that re-pairing does not count as slip.
+  /// stored F*. Slip is measured from the new pairs' gap at the contact displacement of the
+  /// last increment, u_c = u_p,c + F* r_c (zero before the first one), so that re-pairing
+  /// does not count as slip and the next increment's slip is the relative motion at the
+  /// master point where the slave node is now (its convected master coordinate). A slave
+  /// node that had a pair before keeps its λ (the same force in global axes, expressed in
+  /// the new frame) and state as the warm start of the next increment; a new slave node
+  /// starts open with λ = 0.
   /// @throws std::invalid_argument as the constructor
   void set_pairs(std::vector<ContactPair> pairs, Vector mu);
 
@@ -92,6 +96,13 @@ public:
   int contact_dofs() const { return static_cast<int>(F_.rows()); } ///< n_c
 
 private:
+  /// @brief For each of the new pairs, the index of the current pair of its slave node
+  /// (−1 if it had none).
+  std::vector<int> previous_pair_of(const std::vector<ContactPair>& pairs) const;
+  /// @brief The warm start of the new pairs: λ and states carried over by slave node.
+  Vector carried_force(const std::vector<ContactPair>& pairs) const;
+  std::vector<PairState> carried_states(const std::vector<ContactPair>& pairs) const;
+
   /// @brief Message naming held pairs pushed into penetration by q, or empty.
   std::string held_and_penetrating(const Vector& q) const;
 

@@ -36,6 +36,11 @@ public:
   /// @throws std::invalid_argument on a wrong size or non-finite entries
   void set_delassus(Matrix W);
 
+  /// @brief The λ and states the next increment starts from (a warm start only: the
+  /// solution depends on the gap history, not on them), e.g. carried over to new pairs.
+  /// @throws std::invalid_argument on wrong sizes or non-finite λ
+  void set_warm_start(Vector lambda, std::vector<PairState> states);
+
   /// @brief q' of the local problem u = W λ + q' that step(q_total) solves next: q_total
   /// with the last increment's tangential gap removed (sizes as for step()).
   Vector local_q(const Eigen::Ref<const Vector>& q_total) const;
