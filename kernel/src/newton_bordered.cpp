@@ -22,13 +22,17 @@ namespace flexcontact
 {
 namespace
 {
-/// @brief The problem: the local view, the border and the pairs' ρ.
+/// @brief The problem: the local view, the border and the pairs' ρ. The linear systems
+/// are solved for ρ̄ α rather than α (ρ̄ the mean normal ρ): W is of order 1/ρ̄ (1e-11 m/N
+/// for steel), G of order 1, and unscaled the complete orthogonal decomposition would take
+/// the W block for rank deficiency.
 struct Bordered
 {
   const ProblemView& p;
   Eigen::Ref<const Matrix> G;
   Eigen::Ref<const Vector> e;
   Vector rho, rho_t;
+  double rbar;
 };
 
 /// @brief One iterate (λ, α) with q + G α, u, Φ, ψ = Gᵀλ − e, ∂P/∂z and the merit.
@@ -123,7 +127,7 @@ bool newton_direction(const Bordered& b, const Iterate& s, Vector& dl, Vector& d
     Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> D(
         s.dP.data() + kk * d * d, d, d);
     A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - Matrix(D);
-    A.block(a * d, nc * d, d, k).noalias() = Dr * b.G.middleRows(kk * d, d);
+    A.block(a * d, nc * d, d, k).noalias() = Dr * b.G.middleRows(kk * d, d) / b.rbar;
     A.block(nc * d, a * d, k, d) = b.G.middleRows(kk * d, d).transpose();
     rhs.segment(a * d, d) = -s.phi.segment(kk * d, d) - Dr * Wd0.segment(kk * d, d);
   }
@@ -133,7 +137,7 @@ bool newton_direction(const Bordered& b, const Iterate& s, Vector& dl, Vector& d
     return false;
   for (int a = 0; a < nc; ++a)
     dl.segment(closed[a] * d, d) = x.segment(a * d, d);
-  da = x.tail(k);
+  da = x.tail(k) / b.rbar;
   return true;
 }
 
@@ -142,17 +146,17 @@ void all_stick_start(const Bordered& b, Iterate& s)
 {
   const Eigen::Index n = b.p.q.size(), k = b.G.cols();
   Matrix A = Matrix::Zero(n + k, n + k);
-  A.topLeftCorner(n, n) = b.p.W;
+  A.topLeftCorner(n, n) = b.rbar * b.p.W;
   A.topRightCorner(n, k) = b.G;
   A.bottomLeftCorner(k, n) = b.G.transpose();
   Vector rhs(n + k);
-  rhs.head(n) = -b.p.q;
+  rhs.head(n) = -b.rbar * b.p.q;
   rhs.tail(k) = b.e;
   Vector x;
   if (min_norm_solve(A, rhs, x))
   {
     s.lam = x.head(n);
-    s.alpha = x.tail(k);
+    s.alpha = x.tail(k) / b.rbar;
   }
 }
 
@@ -234,7 +238,7 @@ SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const M
   if (!G.allFinite() || !e.allFinite() || !alpha0.allFinite())
     throw std::invalid_argument(who + "G, e or alpha0 is not finite");
   const Vector rho = pair_rho(p);
-  const Bordered b{p, G, e, rho, detail::tangential_rho(p, rho)};
+  const Bordered b{p, G, e, rho, detail::tangential_rho(p, rho), rho.mean()};
   const Eigen::Index n = p.q.size();
 
   Iterate s;

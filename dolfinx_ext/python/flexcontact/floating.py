@@ -202,7 +202,8 @@ class FloatingBodies:
     def no_equilibrium_text(self, G: np.ndarray, e: np.ndarray, lam: np.ndarray,
                             mu: np.ndarray, dim: int) -> Optional[str]:
         """Which body and mode no contact force can balance, from the solver's best
-        iterate λ (its equilibrium rows Gᵀλ = e hold: they are linear), or None.
+        iterate λ (near its equilibrium Gᵀλ = e; where none exists the Newton system is
+        rank deficient and its least-squares steps leave a small imbalance), or None.
 
         A translation: the load the friction must carry along it (e_j less the normal
         forces' share) beyond what friction can hold, Σ μ λ_n |G_t|. A rotation: the
@@ -216,7 +217,7 @@ class FloatingBodies:
             need = abs(e[j] - Gj[:, 0] @ lam_n)
             gt = mu * np.linalg.norm(Gj[:, 1:], axis=1)
             # Tension carries no friction: the decision counts compressive pairs only; the
-            # message gives μN of the iterate's normal forces (its equilibrium rows hold).
+            # message gives μN of the iterate's normal forces.
             hold = float(gt @ np.maximum(lam_n, 0.0))
             if need > hold * (1 + 1e-9) + 1e-12 * abs(e).max():
                 return (f"body '{body}': no static equilibrium: the load along {mode} exceeds "
