@@ -179,3 +179,37 @@ if __name__ == "__main__":
     record = _mpi_record()
     if MPI.COMM_WORLD.rank == 0:
         Path(sys.argv[1], "pushed.json").write_text(json.dumps(record))
+
+
+def test_tall_block_tips_before_it_slides():
+    """μh > b/2: the block tips at Q = N b / (2h) (moment balance about the leading edge),
+    before μN. Close below it the resultant of the contact forces is at the edge of the
+    contact zone (TippingWarning); past it the error names the body and says it tips."""
+    comm = MPI.COMM_WORLD
+    msh, cells, facets, geo = block_on_base.build(comm, block=(0.1, 0.3), h=0.005, h_far=0.02)
+    V = compat.vector_space(msh)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=facets)
+    steel = forms.Material(E_Pa=200e9, nu=0.3)
+    a = forms.elasticity_form(u, v, {tags.BASE: steel, tags.UPPER: steel}, dx, "plane_strain")
+    traction = dolfinx.fem.Constant(msh, np.zeros(2))
+    L = ufl.inner(traction, v) * ds(tags.LOADED)
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    problem = fc.ContactProblem(
+        a, L, fixed, fc.ContactInterface(facets, tags.SLAVE, tags.MASTER, 0.8),
+        bodies=(cells, {"base": tags.BASE, "block": tags.UPPER}), floating=True)
+    b, h = geo["block_width"], geo["block_height"]
+    Q_tip = N * b / (2 * h)
+    assert Q_tip < 0.8 * N
+    traction.value = np.array([0.5 * Q_tip / b, -N / b])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", fc.TippingWarning)
+        problem.step()                       # half way: no warning
+    traction.value = np.array([0.999 * Q_tip / b, -N / b])
+    with pytest.warns(fc.TippingWarning, match=r"body 'block' is about to tip"):
+        problem.step()
+    traction.value = np.array([1.02 * Q_tip / b, -N / b])
+    with pytest.raises(fc.NoEquilibriumError, match=r"body 'block'.*rotation about z.*tips"):
+        problem.step()
+    assert len(problem.increments) == 2

@@ -19,7 +19,6 @@ import warnings
 from typing import Optional
 
 import numpy as np
-from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
@@ -200,7 +199,7 @@ class FloatingBodies:
                           "value (no motion along it)", FreeModeWarning, stacklevel=4)
 
     def no_equilibrium_text(self, G: np.ndarray, e: np.ndarray, lam: np.ndarray,
-                            mu: np.ndarray, dim: int) -> Optional[str]:
+                            mu: np.ndarray, dim: int, x: np.ndarray) -> Optional[str]:
         """Which body and mode no contact force can balance, from the solver's best
         iterate λ (near its equilibrium Gᵀλ = e; where none exists the Newton system is
         rank deficient and its least-squares steps leave a small imbalance), or None.
@@ -210,52 +209,65 @@ class FloatingBodies:
         normal forces of the body's pairs need tension to balance it, so the body tips."""
         L = lam.reshape(-1, dim)
         lam_n = L[:, 0]
+        # Tipping first: the failed iterate of a tipping body pulls on the base at the
+        # trailing edge, or has all its normal force at the leading edge; that of a sliding
+        # body does neither.
+        scale = max(np.abs(lam_n).max(initial=0.0), 1e-300)
+        for b, j0 in self._columns():
+            cols = G[:, j0:j0 + len(b.names)].reshape(-1, dim, len(b.names))
+            mine = np.any(cols != 0, axis=(1, 2))
+            rot = [n for n in b.names if n.startswith("rotation")]
+            if rot and mine.any() and (lam_n[mine].min() < -1e-2 * scale or
+                                       self._resultant_at_edge(b, j0, G, lam_n, x, dim) is not None):
+                return (f"body '{b.name}': no static equilibrium: the load along "
+                        f"{', '.join(rot)} exceeds what contact can hold: the body tips over "
+                        "(its contact force resultant would have to lie beyond the edge of "
+                        "its contact zone)")
         for j, (body, mode) in enumerate(self.names):
             Gj = G[:, j].reshape(-1, dim)
-            if mode.startswith("rotation") or not np.any(Gj):
-                continue
-            need = abs(e[j] - Gj[:, 0] @ lam_n)
             gt = mu * np.linalg.norm(Gj[:, 1:], axis=1)
+            if mode.startswith("rotation") or \
+                    np.abs(Gj[:, 1:]).max() <= 1e-8 * np.abs(Gj).max():
+                continue   # only a translation that friction holds can be pushed past μN
+            need = abs(e[j] - Gj[:, 0] @ lam_n)
             # Tension carries no friction: the decision counts compressive pairs only; the
             # message gives μN of the iterate's normal forces.
             hold = float(gt @ np.maximum(lam_n, 0.0))
             if need > hold * (1 + 1e-9) + 1e-12 * abs(e).max():
                 return (f"body '{body}': no static equilibrium: the load along {mode} exceeds "
                         f"what contact can hold (Q = {need:.6g}, μN = {float(gt @ lam_n):.6g})")
-        scale = max(np.abs(lam_n).max(initial=0.0), 1e-300)
-        for b, j0 in self._columns():
-            cols = G[:, j0:j0 + len(b.names)].reshape(-1, dim, len(b.names))
-            mine = np.any(cols != 0, axis=(1, 2))
-            rot = [n for n in b.names if n.startswith("rotation")]
-            if rot and mine.any() and lam_n[mine].min() < -1e-6 * scale:
-                return (f"body '{b.name}': no static equilibrium: the load along "
-                        f"{', '.join(rot)} exceeds what contact can hold: the body tips over "
-                        "(its contact force resultant would have to lie beyond the edge of "
-                        "its contact zone)")
+        return None
+
+    def _resultant_at_edge(self, b, j0: int, G: np.ndarray, lam_n: np.ndarray,
+                           x: np.ndarray, dim: int) -> Optional[np.ndarray]:
+        """The normal contact force resultant of body b if it lies in the outermost interval
+        of its pairs' positions along a principal axis of its contact zone, else None."""
+        mine = np.flatnonzero(np.any(
+            G[:, j0:j0 + len(b.names)].reshape(-1, dim, len(b.names)) != 0, axis=(1, 2)))
+        ln = np.maximum(lam_n[mine], 0.0)
+        if mine.size < 3 or ln.sum() <= 0:
+            return None
+        P = x[mine]
+        c = P.mean(axis=0)
+        axes = np.linalg.svd(P - c, full_matrices=False)[2][:dim - 1]
+        res = (ln @ P) / ln.sum()
+        for a in axes:
+            s = np.sort((P - c) @ a)
+            r = (res - c) @ a
+            if r <= 0.5 * (s[0] + s[1]) or r >= 0.5 * (s[-1] + s[-2]):
+                return res
         return None
 
     def tipping(self, G: np.ndarray, lam: np.ndarray, x: np.ndarray, dim: int) -> list:
         """Bodies whose normal contact force resultant lies in the outermost interval of
-        their closed pairs' positions (principal axes of the contact zone)."""
-        L = lam.reshape(-1, dim)
+        their pairs' positions (principal axes of the contact zone)."""
+        lam_n = lam.reshape(-1, dim)[:, 0]
         out = []
         for b, j0 in self._columns():
             if not any(n.startswith("rotation") for n in b.names):
                 continue
-            mine = np.flatnonzero(np.any(G[:, j0:j0 + len(b.names)].reshape(-1, dim, len(b.names)) != 0,
-                                         axis=(1, 2)))
-            ln = L[mine, 0]
-            if mine.size < 3 or ln.sum() <= 0:
-                continue
-            P = x[mine]
-            c = P.mean(axis=0)
-            axes = np.linalg.svd(P - c, full_matrices=False)[2][:dim - 1]
-            res = (np.maximum(ln, 0.0) @ P) / np.maximum(ln, 0.0).sum()
-            for a in axes:
-                s = np.sort((P - c) @ a)
-                r = (res - c) @ a
-                if r <= 0.5 * (s[0] + s[1]) or r >= 0.5 * (s[-1] + s[-2]):
-                    out.append(f"body '{b.name}' is about to tip: the contact force resultant "
-                               f"is at the edge of its contact zone (at {np.round(res, 12)})")
-                    break
+            res = self._resultant_at_edge(b, j0, G, lam_n, x, dim)
+            if res is not None:
+                out.append(f"body '{b.name}' is about to tip: the contact force resultant "
+                           f"is at the edge of its contact zone (at {np.round(res, 12)})")
         return out

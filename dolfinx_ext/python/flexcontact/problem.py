@@ -314,7 +314,8 @@ class ContactProblem:
         if lam is None:
             return failure
         text = self.floating.no_equilibrium_text(np.asarray(self.contact.border), e,
-                                                 np.asarray(lam), np.asarray(self.mu), self.dim)
+                                                 np.asarray(lam), np.asarray(self.mu), self.dim,
+                                                 np.asarray(self.pairs.x)[:self.m])
         if text is None:
             return failure
         return (f"increment {number}: {text}. {failure[0].split(': ', 1)[1]}", failure[1], True)
