@@ -15,6 +15,7 @@ from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from conftest import mpirun  # noqa: E402
+from demo_runner import run_demo  # noqa: E402
 
 import dolfinx.fem  # noqa: E402
 
@@ -213,3 +214,17 @@ def test_tall_block_tips_before_it_slides():
     with pytest.raises(fc.NoEquilibriumError, match=r"body 'block'.*rotation about z.*tips"):
         problem.step()
     assert len(problem.increments) == 2
+
+
+def test_demo_against_the_formulas(tmp_path):
+    """demos/pushed_block.py at its defaults (N = 1e5 N/m, μ = 0.3): totals against N and Q,
+    partial slip below μN, the refusal bracketing μN within 1 %, naming the block."""
+    s, _ = run_demo("pushed_block", "--no-plot", results=tmp_path)
+    mu_n = 0.3 * 1e5
+    q = np.array(s["Q_over_muN"]) * mu_n
+    np.testing.assert_allclose(s["normal_total"], 1e5, rtol=1e-9)
+    np.testing.assert_allclose(s["tangential_total"], q, rtol=0, atol=1e-9 * 1e5)
+    assert 0.6 in s["partial_slip_at_Q_over_muN"]
+    fail = s["no_equilibrium"]
+    assert "body 'block'" in fail["message"] and "no static equilibrium" in fail["message"]
+    assert q[-1] < mu_n < fail["Q"] and (fail["Q"] - q[-1]) <= 0.01 * mu_n
