@@ -8,10 +8,10 @@
 #
 #     plane strain: p = δ E / ((H1 + H2)(1 − ν²)),     3D: p = δ E / (H1 + H2).
 #
-# The load is a prescribed displacement rather than a pressure on the top so that the upper
-# block's vertical motion is held by a support as well as by contact (a body held by contact
-# alone needs the force-loaded formulation, not available here); the interface sees the
-# same uniform pressure either way.
+# The load is a prescribed displacement δ of the top (default), or with `--load pressure`
+# the uniform pressure p itself on the top: the upper block's vertical motion is then held
+# by contact alone (`floating=True`: its equilibrium joins the condensed problem, see
+# floating.py); the interface must carry the same uniform pressure either way.
 #
 # The interface is meshed twice: *matching* (both sides the same, non-uniformly spaced
 # nodes) and *non-matching* (2D: the upper side has 1.5 times as many segments, graded the
@@ -33,8 +33,9 @@
 # total force N against p·A, and the displacements against the exact linear field.
 #
 # Run: `/usr/bin/python3 demos/patch_test.py [--dim 2|3] [--cell hexahedron] [--pairing
-# all|NAME]` (also with `mpirun -n 2`); writes results/patch_test/<dim>d/summary.json
-# (hexahedra: results/patch_test/3d_hexahedron/).
+# all|NAME] [--load displacement|pressure]` (also with `mpirun -n 2`); writes
+# results/patch_test/<dim>d/summary.json (hexahedra: 3d_hexahedron; `--load pressure`:
+# a `_pressure` suffix).
 
 # %%
 import argparse
@@ -56,6 +57,8 @@ parser.add_argument("--mesh", choices=("both", "matching", "nonmatching"), defau
 parser.add_argument("--refine", type=int, default=0, help="halve the element sizes N times")
 parser.add_argument("--cell", choices=("tetrahedron", "hexahedron"), default="tetrahedron",
                     help="3D cells (2D: triangles)")
+parser.add_argument("--load", choices=("displacement", "pressure"), default="displacement",
+                    help="the top pushed down by δ, or pressed by the uniform pressure p")
 args = parser.parse_args()
 if args.dim == 2 and args.cell != "tetrahedron":
     parser.error(f"--cell {args.cell} needs --dim 3 (2D meshes are triangles)")
@@ -98,19 +101,26 @@ def run(matching, pairing):
     kind = "3d" if d == 3 else "plane_strain"
     a = forms.elasticity_form(u, v, {tags.BASE: steel, tags.UPPER: steel}, dx, kind)
     bcs, _ = fc.dirichlet(V, facets, tags.FIXED, components=[d - 1])
-    top, (top_v,) = fc.dirichlet(V, facets, tags.LOADED, components=[d - 1])
     sym, _ = fc.dirichlet(V, facets, tags.SYMMETRY_X, components=[0])
-    bcs += top + sym
+    bcs += sym
     if d == 3:
         bcs += fc.dirichlet(V, facets, tags.SYMMETRY_Y, components=[1])[0]
-    top_v.value = -delta_m
+    p, c, e = exact(geo)
+    L = None
+    if args.load == "pressure":
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=facets)
+        L = -p * v[d - 1] * ds(tags.LOADED)
+    else:
+        top, (top_v,) = fc.dirichlet(V, facets, tags.LOADED, components=[d - 1])
+        bcs += top
+        top_v.value = -delta_m
     problem = fc.ContactProblem(
-        a, None, bcs,
+        a, L, bcs,
         fc.ContactInterface(facets, slave=tags.SLAVE, master=tags.MASTER, mu=0.0,
                             name="patch", pairing=pairing),
-        bodies=(cells, {"lower": tags.BASE, "upper": tags.UPPER}))
+        bodies=(cells, {"lower": tags.BASE, "upper": tags.UPPER}),
+        floating=args.load == "pressure")
     s = problem.solve(1, verbose=False)[-1]
-    p, c, e = exact(geo)
     # Displacement error at every node against u = (c x, [c y,] e (v + H1)).
     n_own = V.dofmap.index_map.size_local
     X = V.tabulate_dof_coordinates()[:n_own, :d]
@@ -178,13 +188,14 @@ for matching in meshes:
 # against `p_ref`; `pressure_error_rel` is max |p_node/p − 1| over slave and master nodes.
 
 # %%
-folder = fc.results_folder(f"patch_test/{args.dim}d"
-                           + ("_hexahedron" if cell == "hexahedron" else ""))
+suffix = ("_hexahedron" if cell == "hexahedron" else "") + \
+    ("_pressure" if args.load == "pressure" else "")
+folder = fc.results_folder(f"patch_test/{args.dim}d{suffix}")
 fc.write_summary(folder, {
     "demo": "patch_test", "dim": args.dim, "cell": cell, "units": "SI (m, Pa; N/m in 2D)",
     "materials": {"lower": {"E_Pa": steel.E_Pa, "nu": steel.nu},
                   "upper": {"E_Pa": steel.E_Pa, "nu": steel.nu}},
-    "mu": 0.0, "delta_m": delta_m, "refine": args.refine,
+    "mu": 0.0, "delta_m": delta_m, "refine": args.refine, "load": args.load,
     "geometry": {k: geo[k] for k in ("width", "lower_height", "upper_height", "area")},
     "runs": runs, "ranks": comm.size, "time_s": time.perf_counter() - t_start,
 })

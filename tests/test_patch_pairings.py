@@ -140,3 +140,38 @@ def test_demo_two_ranks_equal_serial(demo, tmp_path):
         ps, pp = np.array(s["p_slave"]), np.array(r["p_slave"])
         assert np.max(np.abs(pp - ps)) <= MPI_TOL * np.max(np.abs(ps)), key
         assert r["N"] == pytest.approx(s["N"], rel=MPI_TOL, abs=0), key
+
+
+# ---- the patch test by pressure: the upper block held only by contact -----------------
+# `--load pressure` presses the top with the exact p instead of moving it by δ; the upper
+# block's vertical motion is then held by contact alone (floating=True). The exact field is
+# the same, so are the bounds.
+
+@pytest.fixture(scope="module", params=[2, 3], ids=["2d", "3d"])
+def demo_pressure(request, tmp_path_factory):
+    dim = request.param
+    s, _ = run_demo("patch_test", "--dim", dim, "--load", "pressure",
+                    results=tmp_path_factory.mktemp("patch_pressure"),
+                    subfolder=f"{dim}d_pressure")
+    return s
+
+
+@pytest.mark.parametrize("pairing", PAIRINGS)
+def test_pressure_load_matching_meshes_exact_for_every_pairing(demo_pressure, pairing):
+    assert demo_pressure["load"] == "pressure"
+    p, width = _exact_pressure(demo_pressure["dim"])
+    r = _runs(demo_pressure)[(True, pairing)]
+    assert r["p_min"] == pytest.approx(p, rel=MATCHING_TOL, abs=0), r
+    assert r["p_max"] == pytest.approx(p, rel=MATCHING_TOL, abs=0), r
+    assert abs(r["N"] / (p * width) - 1) <= MATCHING_TOL, r
+    assert r["u_error_rel"] <= MATCHING_TOL and r["open"] == 0, r
+
+
+def test_pressure_load_nonmatching_surface_to_surface_passes(demo_pressure):
+    p, width = _exact_pressure(demo_pressure["dim"])
+    r = _runs(demo_pressure)[(False, "surface_to_surface")]
+    assert r["slave_nodes"] != r["master_nodes"]
+    for key in ("p_min", "p_max"):
+        assert r[key] == pytest.approx(p, rel=MORTAR_TOL, abs=0), r
+    assert abs(r["N"] / (p * width) - 1) <= MORTAR_TOL, r
+    assert r["u_error_rel"] <= MORTAR_TOL and r["open"] == 0, r

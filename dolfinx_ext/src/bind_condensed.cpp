@@ -43,6 +43,10 @@ py::dict step_dict(const CondensedStep& r, int dim)
       = r.pair_tangential;
   d["pair_tangential"] = py::array_t<double>({t.rows(), t.cols()}, t.data());
   d["report"] = report_dict(r.report);
+  d["alpha"] = py::array_t<double>(r.alpha.size(), r.alpha.data());
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> n
+      = r.undetermined;
+  d["undetermined"] = py::array_t<double>({n.rows(), n.cols()}, n.data());
   return d;
 }
 
@@ -115,13 +119,14 @@ void flexcontact::bind_condensed(py::module& m)
            "pair; constrained: n_c flags of Dirichlet-held contact DOFs (None: none)")
       .def(
           "step",
-          [convergence_error](CondensedContact& c, const Vector& up_c)
+          [convergence_error](CondensedContact& c, const Vector& up_c,
+                              const std::optional<Vector>& e)
           {
             CondensedStep r;
             try
             {
               py::gil_scoped_release release;
-              r = c.step(up_c);
+              r = e ? c.step(up_c, *e) : c.step(up_c);
             }
             catch (const ConvergenceError& e)
             {
@@ -129,18 +134,25 @@ void flexcontact::bind_condensed(py::module& m)
             }
             return step_dict(r, c.dim());
           },
-          py::arg("up_c"),
-          "One increment from the contact-DOF values of u_p = K^-1 p. Returns a dict: lambda, "
+          py::arg("up_c"), py::arg("e") = py::none(),
+          "One increment from the contact-DOF values of u_p = K^-1 p (K^+ p with rigid modes, "
+          "e = -R^T p then: the loads along them). Returns a dict: lambda, "
           "gap (m x d, local frames), slip (m x d-1, this increment), states (0 open, 1 "
           "stick, 2 slip), reaction (n_c, B^T lambda, zero on constrained DOFs), local_q, "
           "normal_force, tangential_force (d, global), max_penetration, pair_tangential "
-          "(m x d, global), report (dict). Raises ConvergenceError with .report (a dict); the "
+          "(m x d, global), alpha (rigid-mode amplitudes), undetermined (k x r directions of "
+          "alpha no contact resists), report (dict). Raises ConvergenceError with .report (a dict); the "
           "history is then unchanged")
       .def("set_flexibility", &CondensedContact::set_flexibility, py::arg("F"),
            "New F* (e.g. another time step): W is rebuilt, pairs and history kept")
       .def("set_pairs", &CondensedContact::set_pairs, py::arg("pairs"), py::arg("mu"),
            "New pairs: B, x0, W rebuilt from the stored F*; history reset, slip measured from "
            "the new pairs' gap at the last contact displacement")
+      .def("set_rigid_modes", &CondensedContact::set_rigid_modes, py::arg("Rc"),
+           "Rigid modes of the bodies held only by contact at the contact DOFs (n_c x k); "
+           "G = B R_c borders the local problem")
+      .def_property_readonly("border", [](const CondensedContact& c) { return c.border(); },
+                             "G = B R_c (m*d x k)")
       .def("local_q", &CondensedContact::local_q, py::arg("q"),
            "q' of the local problem u = W lambda + q' that step solves next for this total q")
       .def_property_readonly("B", [](const CondensedContact& c)

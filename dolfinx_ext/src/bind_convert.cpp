@@ -52,6 +52,12 @@ py::dict report_dict(const SolveReport& r)
   d["residual"] = r.residual;
   d["cycled"] = r.cycled;
   d["attempts"] = r.attempts;
+  if (r.alpha.size())
+  {
+    // Bordered problems: the best iterate, read by the no-equilibrium diagnosis.
+    d["lambda"] = py::array_t<double>(r.lambda.size(), r.lambda.data());
+    d["alpha"] = py::array_t<double>(r.alpha.size(), r.alpha.data());
+  }
   return d;
 }
 

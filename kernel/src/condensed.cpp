@@ -79,6 +79,18 @@ CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
   x0_ = initial_gap(pairs_, X_);
   solver_ = IncrementalSolver(dim_, delassus(B_, F_), mu_, options_);
   solver_.set_initial_gap(x0_);
+  R_ = Matrix::Zero(n_c, 0);
+}
+
+void CondensedContact::set_rigid_modes(Matrix Rc)
+{
+  if (Rc.rows() != F_.rows())
+    throw std::invalid_argument(who + "set_rigid_modes: R_c has " + std::to_string(Rc.rows())
+                                + " rows, expected n_c = " + std::to_string(F_.rows()));
+  if (!Rc.allFinite())
+    throw std::invalid_argument(who + "set_rigid_modes: R_c is not finite");
+  solver_.set_border(B_ * Rc);
+  R_ = std::move(Rc);
 }
 
 void CondensedContact::set_flexibility(Matrix Fstar)
@@ -99,6 +111,8 @@ void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   solver.set_initial_gap(u_c_.size() ? Vector(B * u_c_ + x0) : x0);
   if (!solver_.states().empty())
     solver.set_warm_start(carried_force(pairs), carried_states(pairs));
+  if (R_.cols())
+    solver.set_border(B * R_);
   B_ = std::move(B);
   x0_ = std::move(x0);
   solver_ = std::move(solver);
@@ -175,6 +189,16 @@ std::string CondensedContact::held_and_penetrating(const Vector& q) const
 
 CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c)
 {
+  return step(up_c, Vector::Zero(R_.cols()));
+}
+
+CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
+                                     const Eigen::Ref<const Vector>& e)
+{
+  if (e.size() != R_.cols())
+    throw std::invalid_argument(who + "step: e has " + std::to_string(e.size())
+                                + " entries, expected one per rigid mode ("
+                                + std::to_string(R_.cols()) + ")");
   if (up_c.size() != F_.rows())
     throw std::invalid_argument(who + "step: up_c has " + std::to_string(up_c.size())
                                 + " entries, expected n_c = " + std::to_string(F_.rows()));
@@ -193,7 +217,9 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c)
   CondensedStep r;
   r.local_q = solver_.local_q(q_);
   const Vector previous = solver_.gap();
-  r.report = solver_.step(q_);
+  r.report = solver_.step(q_, e);
+  r.alpha = solver_.alpha();
+  r.undetermined = r.report.undetermined;
   r.lambda = solver_.force();
   r.gap = solver_.gap();
   r.states = solver_.states();
@@ -223,6 +249,8 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c)
       r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
   // Kept for re-pairing: the gap of new pairs at this displacement is their slip origin.
   u_c_ = up_c + F_ * r.reaction;
+  if (R_.cols())
+    u_c_ += R_ * r.alpha;
   return r;
 }
 } // namespace flexcontact

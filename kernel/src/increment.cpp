@@ -73,6 +73,19 @@ IncrementalSolver::IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions
   // Before the first increment nothing has slipped and nothing touches.
   x_ = Vector::Zero(n);
   lambda_ = Vector::Zero(n);
+  G_ = Matrix::Zero(n, 0);
+}
+
+void IncrementalSolver::set_border(Matrix G)
+{
+  const std::string who = "flexcontact: IncrementalSolver::set_border: ";
+  if (G.rows() != W_.rows())
+    throw std::invalid_argument(who + "G has " + std::to_string(G.rows()) + " rows, expected "
+                                + std::to_string(W_.rows()));
+  if (!G.allFinite())
+    throw std::invalid_argument(who + "G is not finite");
+  G_ = std::move(G);
+  alpha_ = Vector::Zero(G_.cols());
 }
 
 void IncrementalSolver::set_initial_gap(const Eigen::Ref<const Vector>& x0)
@@ -126,6 +139,12 @@ Vector IncrementalSolver::local_q(const Eigen::Ref<const Vector>& q_total) const
 
 const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_total)
 {
+  return step(q_total, Vector::Zero(G_.cols()));
+}
+
+const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_total,
+                                           const Eigen::Ref<const Vector>& e)
+{
   const std::string who = "flexcontact: IncrementalSolver::step: ";
   if (q_total.size() != W_.rows())
     throw std::invalid_argument(who + "q has size " + std::to_string(q_total.size())
@@ -136,9 +155,17 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
                                   + std::to_string(i / dim_) + ") is " + num(q_total[i])
                                   + "; q must be finite");
 
+  if (e.size() != G_.cols())
+    throw std::invalid_argument(who + "e has " + std::to_string(e.size())
+                                + " entries but the border G has " + std::to_string(G_.cols())
+                                + " rigid modes");
+  if (!e.allFinite())
+    throw std::invalid_argument(who + "e (the loads along the rigid modes) is not finite");
+
   const Vector q = local_q(q_total);
   const ProblemView view{dim_, W_, q, mu_};
-  SolveReport r = solve(view, lambda_, states_, options_);
+  SolveReport r = G_.cols() ? solve(view, G_, e, lambda_, alpha_, options_)
+                            : solve(view, lambda_, states_, options_);
   if (!r.converged)
   {
     std::string what = "flexcontact: increment did not converge; best residual "
@@ -149,6 +176,11 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
     throw ConvergenceError(what, std::move(r));
   }
   x_ = W_ * r.lambda + q_total;
+  if (G_.cols())
+  {
+    x_ += G_ * r.alpha;
+    alpha_ = r.alpha;
+  }
   lambda_ = r.lambda;
   states_ = r.states;
   last_ = std::move(r);

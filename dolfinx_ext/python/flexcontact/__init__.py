@@ -23,6 +23,7 @@ from .output import ResultWriter, results_folder, write_summary
 from .problem import (ContactInterface, ContactProblem, ContactZoneError, ContactZoneWarning,
                       IncrementSummary)
 from .rigid import RigidTarget
+from .floating import FreeModeWarning, NoEquilibriumError, TippingWarning
 from .dynamics import ImpactProblem, ImpactStepRecord
 
 __version__ = "0.1.0"
@@ -35,5 +36,6 @@ __all__ = [
     "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES", "Ordering",
     "ORDERINGS",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",
+    "NoEquilibriumError", "FreeModeWarning", "TippingWarning",
     "__version__",
 ]

@@ -29,7 +29,8 @@ from .pairing import PAIRINGS, pair_interfaces
 from .postprocess import (STATE_NAMES, ContactFields, IncrementResult,  # noqa: F401
                           IncrementSummary, record_increment)
 from .rigid import RigidTarget
-from .rigid_modes import check_bodies
+from .floating import FloatingBodies, NoEquilibriumError, TippingWarning
+from .rigid_modes import check_bodies, free_bodies
 
 # Annotations use DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never at run time.
 if TYPE_CHECKING:
@@ -150,6 +151,13 @@ class ContactProblem:
     contact : one ContactInterface or a list of them.
     bodies : optional ``(cell_tags, {name: value})``; each body's rigid modes are checked
         so that a singular K is reported with the body's name.
+    floating : with ``bodies``, let contact alone hold the bodies whose rigid modes no
+        Dirichlet condition holds (floating.py): their equilibrium joins the condensed
+        problem as extra equations (FETI style). A mode no load drives and no contact
+        resists takes the minimum-norm value with a FreeModeWarning; a load no contact
+        force can balance raises NoEquilibriumError naming the body and the mode; a body
+        whose contact force resultant reaches the edge of its contact zone gets a
+        TippingWarning. Default False: such a body is an error, as without contact.
     stress : optional callable u -> UFL scalar (e.g. von Mises) written as a DG0 field.
     solver : kernel SolverOptions (tolerance, max_iterations, chain).
     flexibility : "schur" (MUMPS Schur complement; on several ranks PETSc cannot solve with
@@ -180,7 +188,7 @@ class ContactProblem:
                  bodies: Optional[tuple[MeshTags, dict[str, int]]] = None,
                  stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
                  flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto",
-                 repair_pairs: bool = True):
+                 repair_pairs: bool = True, floating: bool = False):
         check_flexibility_method(flexibility)
         if not isinstance(repair_pairs, (bool, np.bool_)):
             raise ValueError(f"repair_pairs={repair_pairs!r}; it must be True or False")
@@ -208,12 +216,22 @@ class ContactProblem:
         t0 = time.perf_counter()
         self.K = assemble_stiffness(self.a_form, self.bcs)
         self.timings["assemble_K_s"] = time.perf_counter() - t0
+        free = []
         if bodies is not None:
             cell_tags, names = bodies
-            check_bodies(self.K, self.V, cell_tags, names, self.comm)
+            if floating:
+                free = free_bodies(self.K, self.V, cell_tags, names, self.comm)
+            else:
+                check_bodies(self.K, self.V, cell_tags, names, self.comm)
+        elif floating:
+            raise ValueError("floating=True needs bodies=(cell_tags, {name: cell tag}) to find "
+                             "the bodies held only by contact")
         t0 = time.perf_counter()
         self.pairs, self.mu, self.m = pair_interfaces(self.V, self.interfaces, self.comm)
         self.timings["pairing_s"] = time.perf_counter() - t0
+        # Bodies held only by contact: fixing DOFs make the factor a generalized inverse.
+        self.floating = (FloatingBodies(self.K, self.V, free, self.bcs, self.pairs, self.comm)
+                         if free else None)
         # Node–surface and rigid-target pairs follow the bodies: re-made before each increment.
         self.repairing = bool(repair_pairs) and any(i.pairing_used != "node_to_node"
                                                     for i in self.interfaces)
@@ -226,6 +244,11 @@ class ContactProblem:
         self.timings.update(c.timings)
         self.factor, self.flex_info, self.n_contact_dofs = c.factor, c.flex_info, c.n_contact_dofs
         self.contact, self.B, self.W, self.x0, self.frames = c.contact, c.B, c.W, c.x0, c.frames
+        if self.floating is not None:
+            Rc = self.floating.contact_modes(c)
+            self.floating.check_touched(Rc)
+            if self.comm.rank == 0:
+                self.contact.set_rigid_modes(Rc)
         self.outputs = ContactFields(self.V, self.comm, stress)
         o = self.outputs
         self.u, self.pressure, self.traction, self.status = o.u, o.pressure, o.traction, o.status
@@ -240,6 +263,10 @@ class ContactProblem:
         if self.repairing:
             self.repair()
         p = assemble_load(self.V, self.a_form, self.L_form, self.bcs, self.comm)
+        e = None
+        if self.floating is not None:
+            e = self.floating.loads(p)       # −Rᵀp, before K⁺ drops the fixing DOFs' loads
+            self.floating.zero_fixed(p)
         up = self.K.createVecRight()
         self.factor.solve(p, up)
         upc = self.condensation.gather(up)
@@ -249,16 +276,19 @@ class ContactProblem:
         if root:
             try:
                 t1 = time.perf_counter()
-                out = self.contact.step(upc)  # the increment's one crossing into the kernel
+                # the increment's one crossing into the kernel
+                out = self.contact.step(upc) if e is None else self.contact.step(upc, e)
                 # the local contact solve alone, for bench/ (the rest is sparse work)
                 self.timings["last_contact_step_s"] = time.perf_counter() - t1
                 q = out["local_q"]
-            except ConvergenceError as e:
-                failure = (f"increment {number}: {e}", dict(getattr(e, "report", {})))
+            except ConvergenceError as err:
+                failure = (f"increment {number}: {err}", dict(getattr(err, "report", {})), None)
+                if e is not None:
+                    failure = self._no_equilibrium(number, e, failure)
                 q = np.asarray(self.contact.local_q(self.contact.last_q))
-            except ValueError as e:
+            except ValueError as err:
                 # e.g. a non-finite u_p: raised on every rank, not left to hang the others
-                failure, q = (f"increment {number}: {e}", None), None
+                failure, q = (f"increment {number}: {err}", None, None), None
             # The increment's local problem u = W λ + q' (slip measured from the last gap),
             # kept for inspection and for cross-checks with other solvers.
             if q is not None:
@@ -269,21 +299,51 @@ class ContactProblem:
                 v.destroy()
             if failure[1] is None:
                 raise ValueError(failure[0])
-            error = ConvergenceError(failure[0])
+            error = (NoEquilibriumError if failure[2] else ConvergenceError)(failure[0])
             error.report = failure[1]  # what the solvers did, on every rank
             raise error
         r = self.condensation.reaction(out["reaction"] if root else None)
         r.axpy(1.0, p)
         self.factor.solve(r, compat.petsc_vec(self.u))
+        if self.floating is not None:
+            alpha = self.comm.bcast(out["alpha"] if root else None, root=0)
+            self.floating.add_modes(compat.petsc_vec(self.u), alpha)
         self.u.x.scatter_forward()
         for v in (p, up, r):
             v.destroy()
         inc = record_increment(out, number, self.u, self.comm, self.dim,
                                time.perf_counter() - t0)
         self.increments.append(inc)
+        if self.floating is not None:
+            inc.alpha = alpha
+            self._floating_warnings(out, number)
         self.outputs.write_back(inc, self.pairs)
         self._guard_zone(inc)
         return inc
+
+    def _no_equilibrium(self, number: int, e: np.ndarray, failure: tuple) -> tuple:
+        """The failure of a bordered increment, with the body and mode that no contact force
+        can balance when the solver's best iterate shows one (rank 0)."""
+        lam = failure[1].get("lambda")
+        if lam is None:
+            return failure
+        text = self.floating.no_equilibrium_text(np.asarray(self.contact.border), e,
+                                                 np.asarray(lam), np.asarray(self.mu), self.dim,
+                                                 np.asarray(self.pairs.x)[:self.m])
+        if text is None:
+            return failure
+        return (f"increment {number}: {text}. {failure[0].split(': ', 1)[1]}", failure[1], True)
+
+    def _floating_warnings(self, out, number: int) -> None:
+        """FreeModeWarning for modes no contact resists, TippingWarning for bodies about to
+        tip (rank 0)."""
+        if self.comm.rank != 0:
+            return
+        self.floating.warn_undetermined(np.asarray(out["undetermined"]), number)
+        x = np.asarray(self.pairs.x)[:self.m]
+        for text in self.floating.tipping(np.asarray(self.contact.border),
+                                          np.asarray(out["lambda"]).ravel(), x, self.dim):
+            warnings.warn(f"increment {number}: {text}", TippingWarning, stacklevel=3)
 
     def repair(self) -> None:
         """Re-make node–surface and rigid-target pairs at the current positions (the last

@@ -33,6 +33,8 @@ struct CondensedStep
   Vector tangential_force;        ///< d, Σ_k T_kᵀ (0, λ_t,k): the total friction force
   double max_penetration = 0.0;   ///< max(0, −min_k x_n,k)
   Matrix pair_tangential;         ///< m × d, T_kᵀ (0, λ_t,k) per pair
+  Vector alpha;                   ///< k rigid-mode amplitudes (bodies held only by contact)
+  Matrix undetermined;            ///< k × r directions of α no contact resists (α = 0 there)
 };
 
 /// @brief Pairs, B, x0, W = B F* Bᵀ and the incremental driver of one contact problem.
@@ -60,6 +62,21 @@ public:
   /// penetration (no contact force can open it), or if no solver converges; the history is
   /// then unchanged
   CondensedStep step(const Eigen::Ref<const Vector>& up_c);
+
+  /// @brief One increment with bodies held only by contact (set_rigid_modes): up_c are the
+  /// contact-DOF values of K⁺ p (K⁺ a generalized inverse), e = −Rᵀ p the loads along the
+  /// rigid modes; the gap is W λ + q + G α with G = B R_c, and Gᵀ λ = e.
+  /// @throws as step(up_c); std::invalid_argument if e's size is not the mode count
+  CondensedStep step(const Eigen::Ref<const Vector>& up_c, const Eigen::Ref<const Vector>& e);
+
+  /// @brief Rigid modes R_c (n_c × k: the values at the contact DOFs of the free rigid modes
+  /// of the bodies held only by contact); G = B R_c is kept up to date with the pairs.
+  /// k = 0 removes them. The rigid-mode amplitude restarts at zero.
+  /// @throws std::invalid_argument on a wrong row count or non-finite entries
+  void set_rigid_modes(Matrix Rc);
+
+  const Matrix& rigid_modes() const { return R_; }            ///< R_c, n_c × k
+  const Matrix& border() const { return solver_.border(); }  ///< G = B R_c
 
   /// @brief Replace F* (e.g. K_eff⁻¹ for another time step) and rebuild W. Pairs and history
   /// (gap, λ, states) are kept: the next increment starts from them.
@@ -117,6 +134,7 @@ private:
   Vector x0_;
   IncrementalSolver solver_;
   Vector q_;          ///< q of the last step() call
-  Vector u_c_;        ///< contact displacement of the last increment, u_p,c + F* r_c
+  Vector u_c_;        ///< contact displacement of the last increment, u_p,c + F* r_c + R_c α
+  Matrix R_;          ///< rigid modes at the contact DOFs, n_c × k
 };
 } // namespace flexcontact

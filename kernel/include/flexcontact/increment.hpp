@@ -26,6 +26,17 @@ public:
   /// @throws ConvergenceError if no solver of the chain converges (history left unchanged)
   const SolveReport& step(const Eigen::Ref<const Vector>& q_total);
 
+  /// @brief The bordered increment of bodies held only by contact: the gap is
+  /// x = W λ + q + G α and the bodies' equilibrium Gᵀ λ = e holds (e = −Rᵀ p of the total
+  /// load). α is the rigid-mode amplitude (total, not incremental).
+  /// @throws std::invalid_argument if no border is set or e has the wrong size
+  const SolveReport& step(const Eigen::Ref<const Vector>& q_total,
+                          const Eigen::Ref<const Vector>& e);
+
+  /// @brief Set the border G = B R_c (m·d × k; k = 0 removes it); α restarts at zero.
+  /// @throws std::invalid_argument on a wrong row count or non-finite entries
+  void set_border(Matrix G);
+
   /// @brief Gap before the first increment (default 0): the tangential slip of the first
   /// increment is measured from it, so an initial tangential offset is not taken as slip.
   /// @throws std::invalid_argument on a wrong size or non-finite values
@@ -47,6 +58,8 @@ public:
 
   const Vector& gap() const { return x_; }          ///< total gap x of the last increment
   const Vector& force() const { return lambda_; }   ///< λ of the last increment
+  const Vector& alpha() const { return alpha_; }    ///< rigid-mode amplitudes (bordered)
+  const Matrix& border() const { return G_; }       ///< G, m·d × k (k = 0: none)
   const std::vector<PairState>& states() const { return states_; }
   const SolveReport& last() const { return last_; }
   int dim() const { return dim_; }
@@ -59,6 +72,8 @@ private:
   Vector mu_;
   SolverOptions options_;
   Vector x_, lambda_;
+  Matrix G_;
+  Vector alpha_;
   std::vector<PairState> states_;
   SolveReport last_;
 };

@@ -74,6 +74,11 @@ struct SolveReport
   bool converged = false;
   bool cycled = false;              ///< active set revisited an earlier state vector
   std::vector<std::string> attempts; ///< one line per solver tried, in order, with outcome
+  /// Bordered problems only (solvers.hpp: solve_newton_bordered): the rigid-mode amplitudes
+  /// α of the bodies held only by contact, and an orthonormal basis (k × r) of the
+  /// directions of α that no closed pair resists (set to zero: the minimum-norm answer).
+  Vector alpha;
+  Matrix undetermined;
 };
 
 } // namespace flexcontact

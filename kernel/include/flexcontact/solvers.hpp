@@ -35,6 +35,28 @@ SolveReport solve_projection(const ProblemView& p, const Eigen::Ref<const Vector
 SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                             const SolverOptions& opt);
 
+/// @brief Semi-smooth Newton on the bordered problem of bodies held only by contact:
+/// u = W λ + q + G α with the Alart–Curnier conditions on (λ, u) and the bodies' equilibrium
+/// Gᵀ λ = e (G = B R_c, R the rigid modes; e = −Rᵀ p). The Jacobian is
+/// [[(I − D) + D ρ W, D ρ G], [Gᵀ, 0]] on the closed pairs and α; it is solved by a
+/// complete orthogonal decomposition, so a direction of α that no closed pair resists
+/// (a frictionless block's slide) gets no step, and is reported in `undetermined` with α
+/// zero along it. With no closed pair at the start (λ0 zero), the all-stick system
+/// [[W, G], [Gᵀ, 0]] [λ; α] = [−q; e] gives the start. The residual is the larger of the
+/// natural-map residual at q + G α and ‖Gᵀλ − e‖ / max(‖e‖, ‖|G|ᵀ|λ|‖).
+SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const Matrix>& G,
+                                  const Eigen::Ref<const Vector>& e,
+                                  const Eigen::Ref<const Vector>& lambda0,
+                                  const Eigen::Ref<const Vector>& alpha0,
+                                  const SolverOptions& opt);
+
+/// @brief The chain for a bordered problem: only "newton_ac" handles the equilibrium rows
+/// (as solve_newton_bordered); the other solvers of the chain are skipped, each with a line
+/// in `attempts`. Tried from (λ0, α0), then from the all-stick start.
+SolveReport solve(const ProblemView& p, const Eigen::Ref<const Matrix>& G,
+                  const Eigen::Ref<const Vector>& e, const Eigen::Ref<const Vector>& lambda0,
+                  const Eigen::Ref<const Vector>& alpha0, const SolverOptions& opt);
+
 /// @brief Names accepted in SolverOptions::chain: "active_set", "projection", "newton_ac".
 std::vector<std::string> solver_names();
 
