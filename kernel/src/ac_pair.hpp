@@ -91,6 +91,20 @@ inline Vector tangential_rho(const ProblemView& p, const Vector& rho_n)
 /// their block was too degenerate for an exact local solve.
 int nsgs_sweep(const ProblemView& p, const Vector& rho, Vector& lam, Vector& u);
 
+/// @brief How the chain runs the Alart–Curnier Newton beyond its public defaults.
+struct NewtonSettings
+{
+  /// ρ from each pair's diagonal block, 1/‖W_kk‖₂ for all components (Siconos' NSN_AC
+  /// scaling), instead of 1/W_nn normal and 1/λ_max(tangential block).
+  bool block_rho = false;
+  /// Newton steps allowed: this × SolverOptions::max_iterations.
+  int iteration_factor = 1;
+};
+
+/// @brief The Newton of solve_newton_ac() with the given settings (newton_ac.cpp).
+SolveReport newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                      const SolverOptions& opt, const NewtonSettings& settings);
+
 /// @brief Throws std::invalid_argument naming what is wrong with a problem and its start λ.
 inline void check_problem(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                           const char* who)
