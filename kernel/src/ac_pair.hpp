@@ -28,7 +28,9 @@ inline void ac_pair(const double* lam, const double* u, double mu, double rho_n,
     z[i] = lam[i] - rho_t * u[i];
   const double xi = z[0] > 0.0 ? z[0] : 0.0;
   const double r = mu * xi;
-  const double zt = d == 2 ? std::abs(z[1]) : std::hypot(z[1], z[2]);
+  // sqrt, not hypot: 5% of a chain solve under callgrind; z is a force (λ − ρu), far from
+  // the overflow range hypot guards against.
+  const double zt = d == 2 ? std::abs(z[1]) : std::sqrt(z[1] * z[1] + z[2] * z[2]);
   double P[3];
   P[0] = xi;
   // "Inside" needs r > 0: with r = 0 the disc is a point and the derivative is 0, otherwise
