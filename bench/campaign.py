@@ -10,6 +10,8 @@ problems the chain lost that another solver solved (must be 0), the worst residu
 claimed answer, and median times.
 
     /usr/bin/python3 bench/campaign.py [--count 10000] [--large 4] [--seed 1]   # about 40 min
+    /usr/bin/python3 bench/campaign.py --count 2000 --large 0 --also "$(python3 -c \
+        'import json; print(",".join(x["problem"] for x in json.load(open("bench/campaign.json"))["lost_by_the_chain"]))')"
 """
 import argparse
 import json
@@ -31,6 +33,8 @@ ap.add_argument("--large", type=int, default=4, help="problems with 300-1000 pai
 ap.add_argument("--seed", type=int, default=1)
 ap.add_argument("--tolerance", type=float, default=1e-10)
 ap.add_argument("--no-siconos", action="store_true")
+ap.add_argument("--also", default="", help="comma-separated problem names of a larger sample "
+                "of the same seed (e.g. those an earlier run lost) to run as well")
 ap.add_argument("--out", default=str(HERE / "campaign.json"))
 args = ap.parse_args()
 
@@ -58,7 +62,13 @@ def summary(outcomes):
 def report(done, final):
     """Write campaign.json (also on the way, so that a long run leaves results)."""
     classes = {k: {s: summary(v) for s, v in rows.items()} for k, rows in sorted(by_class.items())}
-    result = {"tolerance": args.tolerance, "seed": args.seed, "problems": len(problems),
+    for rows in classes.values():
+        if "siconos_NSN_AC" in rows:
+            rows["chain_median_over_siconos"] = (rows["chain"]["median_time_s"]
+                                                 / rows["siconos_NSN_AC"]["median_time_s"])
+    result = {"tolerance": args.tolerance, "seed": args.seed, "count": args.count,
+              "large": args.large, "also": sorted(set(args.also.split(",")) - {""}),
+              "problems": len(problems),
               "done": done, "siconos": siconos, "wrong_answers": wrong,
               "lost_by_the_chain": lost, "classes": classes,
               "time_s": time.perf_counter() - t0}
@@ -79,6 +89,13 @@ def report(done, final):
 
 t0 = time.perf_counter()
 problems = sample(args.seed, args.count, sizes=(1, 60), large=args.large)
+n_sample = len(problems)
+if args.also:
+    # Problem i of a seed is the same whatever the count, as long as i < count (large ones
+    # come after): draw up to the last one asked for and keep those named.
+    names = set(args.also.split(",")) - {p.name for p in problems}
+    last = max(int(n.rsplit("-", 1)[1]) for n in names) if names else -1
+    problems += [p for p in sample(args.seed, last + 1, sizes=(1, 60)) if p.name in names]
 by_class = defaultdict(lambda: defaultdict(list))
 lost, wrong = [], []
 for i, p in enumerate(problems, 1):
@@ -87,7 +104,8 @@ for i, p in enumerate(problems, 1):
         # Siconos prints its LU failures (zero rows of W) on stdout: keep them off the table.
         with CapturedOutput():
             row["siconos_NSN_AC"] = run_siconos(p, args.tolerance)
-    key = f"{p.kind}/{p.dim}d" + ("/large" if p.m >= 300 else "")
+    key = (f"{p.kind}/{p.dim}d" + ("/large" if p.m >= 300 else "")
+           + ("/also" if i > n_sample else ""))
     for s, o in row.items():
         by_class[key][s].append(o)
         if o.wrong or (o.claimed and not o.finite):

@@ -182,3 +182,36 @@ class _AsCase:
 
     def __init__(self, p: RandomProblem):
         self.W, self.q, self.mu_pairs, self.m = p.W, p.q, p.mu, p.m
+
+
+# ---- stored problems (kernel/tests/test_hard_random.cpp) ------------------------------
+def write_problem(problem: RandomProblem, path) -> None:
+    """Store one problem for the kernel's GoogleTests: an ASCII header (name, dim, pairs),
+    then little-endian float64 μ (m), W's upper triangle by rows, q and the constructed
+    solution λ* (n = m·d each)."""
+    n = problem.unknowns
+    header = (f"flexcontact-random-problem 1\nname {problem.name}\ndim {problem.dim}\n"
+              f"pairs {problem.m}\nbinary float64 little-endian: mu, W upper by rows, q, "
+              f"lambda_star\n")
+    body = np.concatenate([problem.mu, problem.W[np.triu_indices(n)], problem.q,
+                           problem.lam_star]).astype("<f8")
+    with open(path, "wb") as f:
+        f.write(header.encode())
+        f.write(body.tobytes())
+
+
+def problem_by_name(name: str, seed: int = 1, count: int = 10000, sizes=(1, 60),
+                    large: int = 0) -> RandomProblem:
+    """The problem of that name in ``sample(seed, count, sizes, large)`` (as bench/campaign.py
+    names them), regenerated from its seed: problems are drawn in sequence, so all those
+    before it are drawn too."""
+    index = int(name.rsplit("-", 1)[1])
+    rng = np.random.default_rng(seed)
+    for i in range(index + 1):
+        kind = CLASSES[i % len(CLASSES)]
+        dim = 2 + (i // len(CLASSES)) % 2
+        lo, hi = sizes if i < count else (300, 1000)
+        p = make_problem(rng, kind, dim, int(rng.integers(lo, hi + 1)), i)
+    if p.name != name:
+        raise ValueError(f"name={name!r}: problem {index} of seed {seed} is {p.name!r}")
+    return p

@@ -8,6 +8,7 @@
 
 #include "ac_pair.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <algorithm>
@@ -16,10 +17,29 @@
 #include <string>
 #include <vector>
 
+
 namespace flexcontact
 {
 namespace
 {
+/// @brief ρ of every pair from its diagonal block, as Siconos' NSN_AC scales it: 1/‖W_kk‖₂
+/// for the normal and the tangential components alike (fallback where the block vanishes).
+void spectral_rho(const ProblemView& p, const Vector& fallback, Vector& rn, Vector& rt)
+{
+  const int d = p.dim;
+  rn.resize(p.pairs());
+  rt.resize(p.pairs());
+  for (int k = 0; k < p.pairs(); ++k)
+  {
+    Matrix B = 0.5 * (p.W.block(k * d, k * d, d, d) + p.W.block(k * d, k * d, d, d).transpose());
+    const double w = Eigen::SelfAdjointEigenSolver<Matrix>(B, Eigen::EigenvaluesOnly)
+                         .eigenvalues()
+                         .cwiseAbs()
+                         .maxCoeff();
+    rn[k] = (std::isfinite(w) && w > 1e-12 / fallback[k]) ? 1.0 / w : fallback[k];
+    rt[k] = rn[k];
+  }
+}
 /// @brief Φ(λ) for all pairs from λ and u = Wλ + q; optionally the blocks ∂P/∂z (d×d each).
 void ac_all(const ProblemView& p, const Vector& rho, const Vector& rho_t, const Vector& lam,
             const Vector& u, Vector& phi, std::vector<double>* dP)
@@ -220,12 +240,22 @@ void finish_report(const ProblemView& p, const Vector& lam, int it, int sweeps_u
 SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                             const SolverOptions& opt)
 {
+  return detail::newton_ac(p, lambda0, opt, detail::NewtonSettings{});
+}
+
+SolveReport detail::newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+                              const SolverOptions& opt, const NewtonSettings& settings)
+{
   detail::check_problem(p, lambda0, "solve_newton_ac");
   const int d = p.dim;
   const int m = p.pairs();
   const int n = m * d;
-  const Vector rho = pair_rho(p);
-  const Vector rho_t = detail::tangential_rho(p, rho);
+  const Vector rho_res = pair_rho(p);
+  Vector rho = rho_res;
+  Vector rho_t = detail::tangential_rho(p, rho);
+  if (settings.block_rho)
+    spectral_rho(p, rho_res, rho, rho_t);
+  const long maxit = static_cast<long>(opt.max_iterations) * std::max(settings.iteration_factor, 1);
 
   SolveReport rep;
   rep.solver = "newton_ac";
@@ -238,7 +268,7 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
   closed.reserve(m);
 
   double f = merit(p, rho, rho_t, lam, u, phi, dP);
-  double res = natural_map_residual(p, lam, u, rho);
+  double res = natural_map_residual(p, lam, u, rho_res);
   int it = 0;
   std::string why;
   int last_gain = 0, sweeps_used = 0;
@@ -246,7 +276,7 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
   // Iterations without halving the residual before Newton is declared stalled.
   constexpr int stall = 8;
   MeritHistory history(f);
-  while (res > opt.tolerance && it < opt.max_iterations)
+  while (res > opt.tolerance && it < maxit)
   {
     ++it;
     closed_pairs(dP, m, d, closed);
@@ -260,7 +290,7 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
     {
       // Stalled: the sweeps move λ to where Newton converges fast again.
       ++sweeps_used;
-      gauss_seidel_sweeps(p, rho, opt.tolerance, lam, u, res);
+      gauss_seidel_sweeps(p, rho_res, opt.tolerance, lam, u, res);
       if (!lam.allFinite())
       {
         why = ", non-finite iterate";
@@ -282,7 +312,7 @@ SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>
       u.swap(trial.u);
     f = merit(p, rho, rho_t, lam, u, phi, dP);
     history.push(f);
-    res = natural_map_residual(p, lam, u, rho);
+    res = natural_map_residual(p, lam, u, rho_res);
     if (res < 0.5 * best)
     {
       best = res;

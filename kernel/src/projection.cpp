@@ -47,17 +47,19 @@ bool local_newton(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
     const double f = phi.head(d).squaredNorm();
     if (std::sqrt(f) <= 1e-15 * scale())
       return true;
-    Mat3 J = Mat3::Identity();
-    const Mat3 R = Vec3(rho, rt, rt).asDiagonal();
+    // Fixed 3×3 even in 2D (row and column 2 of D and A are zero, so J's are e₂): the
+    // dynamic-size d×d LU and temporaries cost 15% of a chain solve under callgrind.
+    const Vec3 R(rho, rt, rt);
     Mat3 D = Mat3::Zero();
     for (int i = 0; i < d; ++i)
       for (int j = 0; j < d; ++j)
         D(i, j) = dPr[i * d + j];
-    J.topLeftCorner(d, d) = Eigen::MatrixXd::Identity(d, d)
-                            - D.topLeftCorner(d, d)
-                                  * (Eigen::MatrixXd::Identity(d, d) - R * A.topLeftCorner(d, d));
-    Vec3 dl = Vec3::Zero();
-    dl.head(d) = J.topLeftCorner(d, d).fullPivLu().solve(-phi.head(d));
+    const Mat3 J = Mat3::Identity() - D * (Mat3::Identity() - R.asDiagonal() * A);
+    // Partial pivoting first (a third of the full-pivoting cost); full pivoting only when
+    // J is singular, where it still gives a finite direction.
+    Vec3 dl = J.partialPivLu().solve(-phi);
+    if (!dl.allFinite())
+      dl = J.fullPivLu().solve(-phi);
     if (!dl.allFinite())
       return false;
     double alpha = 1.0;
@@ -167,11 +169,15 @@ bool local_solve(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
   }
   // Stick: u = 0.
   {
-    const auto lu = A.topLeftCorner(d, d).fullPivLu();
+    // Fixed-size LU (A's row and column 2 are zero in 2D: solve with a unit there).
+    Mat3 As = A;
+    if (d == 2)
+      As(2, 2) = A(0, 0); // on the block's scale: FullPivLU's rank threshold is relative
+    const Eigen::FullPivLU<Mat3> lu(As);
     if (lu.isInvertible())
     {
-      Vec3 s = Vec3::Zero();
-      s.head(d) = lu.solve(-c.head(d));
+      Vec3 s = lu.solve(-c);
+      s[2] = d == 2 ? 0.0 : s[2];
       if (s.allFinite() && s[0] >= 0.0 && tnorm(s, d) <= mu * s[0])
       {
         lam = s;

@@ -67,8 +67,12 @@ std::vector<std::string> default_chain();
 /// With the default chain and 300 unknowns or more, 50 projection sweeps come first as a
 /// warm start (recorded in `attempts`): they settle most pairs' states cheaply, and Newton
 /// then needs a step or two. Each solver is tried from the best answer so far and from the
-/// caller's start (the active set from the caller's first). The report is the converging solver's, with `attempts` listing every try; if none
-/// converges it is the best one's (smallest residual) with converged=false.
+/// caller's start (the active set from the caller's first). Newton from the caller's start
+/// gets 10 × max_iterations steps (ill-conditioned problems need hundreds of damped ones);
+/// if it fails, Newton runs once more from zero with each pair's ρ = 1/‖W_kk‖₂ (Siconos'
+/// NSN_AC scaling), which solves a different subset of the hard problems. The report is the
+/// converging solver's, with `attempts` listing every try; if none converges it is the best
+/// one's (smallest residual) with converged=false.
 SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                   const std::vector<PairState>& states0, const SolverOptions& opt);
 } // namespace flexcontact
