@@ -21,10 +21,13 @@ ORDERED = ["metis", "amd", "amf", "pord", "qamd"]
 
 @pytest.fixture(scope="module")
 def box3d():
-    """A small 3D box (6³ cells, 1,029 DOFs) and its top-face contact DOFs."""
+    """A small 3D box (6³ cells, 1,029 DOFs) and its top-face contact DOFs. The mesh stays
+    alive until the module's tests end: on DOLFINx 0.9, K's communicator is the mesh's and
+    is freed with it, so PETSc could create no object on it afterwards."""
     msh, V, K, tags = elasticity(6, 3)
     _, dofs = contact_dofs(V, tags)
-    return K, dofs
+    yield K, dofs
+    del msh
 
 
 @pytest.mark.parametrize("method", ["schur", "inverse_entries", "matmatsolve"])
