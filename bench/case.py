@@ -39,6 +39,7 @@ from flexcontact import _cpp, compat, forms
 from flexcontact.assembly import assemble_load, assemble_stiffness
 from flexcontact.info import describe
 from flexcontact.meshes import hertz2d, hertz3d, tags
+from timing import median_time  # bench/ is the script's folder, on sys.path
 
 R_M, A_M = 0.05, 0.005  # sphere/cylinder radius and the aimed contact half-width (m)
 STEEL = forms.Material(E_Pa=200e9, nu=0.3)
@@ -107,14 +108,6 @@ def model(spec: dict) -> dict:
             "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
             "contact_nodes_per_surface": int(geo.get("n_contact_nodes", 0))}
 
-
-def median_time(fn, n: int) -> float:
-    ts = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
 
 
 def compiled_form(a):

@@ -10,10 +10,8 @@ bench/increment_cost.json with the ratios (b)/(a) and (c)/(d).
 """
 import argparse
 import json
-import time
 from pathlib import Path
 
-import numpy as np
 import ufl
 from mpi4py import MPI
 
@@ -21,6 +19,7 @@ import flexcontact as fc
 from flexcontact import compat, forms
 from flexcontact.info import describe
 from flexcontact.meshes import hertz2d, tags
+from timing import median_time  # bench/ is the script's folder, on sys.path
 
 ap = argparse.ArgumentParser(description=__doc__)
 ap.add_argument("--refine", type=int, nargs="+", default=[0, 1, 2, 3])
@@ -30,14 +29,6 @@ comm = MPI.COMM_WORLD
 steel = forms.Material(E_Pa=200e9, nu=0.3)
 R, a_target = 0.05, 0.005
 
-
-def median_time(fn, n):
-    ts = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
 
 
 rows = []

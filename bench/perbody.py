@@ -28,6 +28,7 @@ import flexcontact as fc
 from flexcontact import _cpp, compat, forms
 from flexcontact.info import describe
 from flexcontact.meshes import block_on_base, hertz2d, hertz3d, tags
+from timing import median_time  # bench/ is the script's folder, on sys.path
 
 OUT = Path(__file__).with_name("perbody.json")
 steel = forms.Material(E_Pa=200e9, nu=0.3)
@@ -102,14 +103,6 @@ def vm(key):
             return int(line.split()[1]) / 1024.0
     return float("nan")
 
-
-def median_time(fn, n):
-    ts = []
-    for _ in range(n):
-        t0 = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
 
 
 TIMES = ("factorization_s", "schur_s", "inverse_s", "blocks_s", "ordering_s", "analysis_s",

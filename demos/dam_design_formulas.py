@@ -19,7 +19,6 @@
 # %%
 import argparse
 import csv
-import math
 import time
 
 import numpy as np

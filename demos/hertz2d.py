@@ -127,20 +127,10 @@ if comm.rank == 0:
           f"p0 = {p0:.5e} Pa (ref {p0_ref:.5e}, {100 * (p0 / p0_ref - 1):+.2f}%)")
 
     if not args.no_plot:
-        plt = fc.output.pyplot()
-        xs = np.linspace(-1.5 * a_ref, 1.5 * a_ref, 400)
-        fig, ax = plt.subplots(figsize=(7, 4))
-        ax.plot(xs * 1e3, [analytic.hertz_pressure(xi, a_ref, p0_ref) / 1e6 for xi in xs],
-                "k-", label="Hertz")
-        ax.plot(x * 1e3, p / 1e6, "o", ms=4, label="flexcontact: pressure")
-        ax.plot(x * 1e3, q[:, 0] / 1e6, "s", ms=3, label="flexcontact: tangential traction")
-        ax.set_xlim(-1.5 * a_ref * 1e3, 1.5 * a_ref * 1e3)
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("traction [MPa]")
-        ax.set_title(f"Hertz cylinder, P = {P / 1e6:.2f} MN/m: a {100 * (a_fit / a_ref - 1):+.1f}%,"
-                     f" p0 {100 * (p0 / p0_ref - 1):+.1f}%")
-        ax.grid(alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(folder / "hertz2d.png", dpi=120)
+        fc.output.plot_hertz_profile(
+            folder / "hertz2d.png", x, p, a_ref, p0_ref, label="flexcontact: pressure",
+            ylabel="traction [MPa]",
+            extra=[(x, q[:, 0], "s", "flexcontact: tangential traction")],
+            title=f"Hertz cylinder, P = {P / 1e6:.2f} MN/m: a {100 * (a_fit / a_ref - 1):+.1f}%,"
+                  f" p0 {100 * (p0 / p0_ref - 1):+.1f}%")
     print(f"results in {folder}/")

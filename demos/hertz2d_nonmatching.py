@@ -150,19 +150,9 @@ if comm.rank == 0:
           f"factorizations {summary['factorizations']}")
 
     if not args.no_plot:
-        plt = fc.output.pyplot()
-        xs = np.linspace(-1.5 * a_ref, 1.5 * a_ref, 400)
-        fig, ax = plt.subplots(figsize=(7, 4))
-        ax.plot(xs * 1e3, [analytic.hertz_pressure(xi, a_ref, p0_ref) / 1e6 for xi in xs],
-                "k-", label="Hertz")
-        ax.plot(x * 1e3, p / 1e6, "o", ms=4, label=f"flexcontact, {args.slave} as slave")
-        ax.set_xlim(-1.5 * a_ref * 1e3, 1.5 * a_ref * 1e3)
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("pressure [MPa]")
-        ax.set_title(f"Non-matching Hertz: a {100 * (a_fit / a_ref - 1):+.1f}%, "
-                     f"p0 {100 * (p0 / p0_ref - 1):+.1f}%")
-        ax.grid(alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(folder / f"{name}.png", dpi=120)
+        fc.output.plot_hertz_profile(
+            folder / f"{name}.png", x, p, a_ref, p0_ref,
+            label=f"flexcontact, {args.slave} as slave",
+            title=f"Non-matching Hertz: a {100 * (a_fit / a_ref - 1):+.1f}%, "
+                  f"p0 {100 * (p0 / p0_ref - 1):+.1f}%")
     print(f"results in {folder}/")

@@ -102,17 +102,6 @@ if comm.rank == 0:
     print(f"rigid cylinder: a = {a_fit:.5e} m (ref {a_ref:.5e}, {100 * (a_fit / a_ref - 1):+.2f}%),"
           f" p0 = {p0:.5e} Pa (ref {p0_ref:.5e}, {100 * (p0 / p0_ref - 1):+.2f}%)")
     if not args.no_plot:
-        plt = fc.output.pyplot()
-        xs = np.linspace(-1.5 * a_ref, 1.5 * a_ref, 400)
-        fig, ax = plt.subplots(figsize=(7, 4))
-        ax.plot(xs * 1e3, [analytic.hertz_pressure(xi, a_ref, p0_ref) / 1e6 for xi in xs],
-                "k-", label="Hertz (rigid cylinder)")
-        ax.plot(x * 1e3, p / 1e6, "o", ms=4, label="flexcontact")
-        ax.set_xlim(-1.5 * a_ref * 1e3, 1.5 * a_ref * 1e3)
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("pressure [MPa]")
-        ax.grid(alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(folder / "rigid_cylinder.png", dpi=120)
+        fc.output.plot_hertz_profile(folder / "rigid_cylinder.png", x, p, a_ref, p0_ref,
+                                     ref_label="Hertz (rigid cylinder)")
     print(f"results in {folder}/")

@@ -5,7 +5,7 @@ import json
 import os
 from dataclasses import asdict
 from pathlib import Path
-from typing import TYPE_CHECKING, Sequence, Union
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import numpy as np
 from mpi4py import MPI
@@ -163,3 +163,32 @@ def pyplot():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     return plt
+
+
+def plot_hertz_profile(path: Union[str, os.PathLike], x_m, p_Pa, a_ref_m: float,
+                       p0_ref_Pa: float, *, ref_label: str = "Hertz",
+                       label: str = "flexcontact", title: Optional[str] = None,
+                       ylabel: str = "pressure [MPa]", extra=()) -> None:
+    """A line contact's computed pressure against Hertz's ellipse over ±1.5 a, in mm and MPa.
+
+    ``extra``: more computed series as ``(x_m, y_Pa, marker, label)`` (e.g. the tangential
+    traction)."""
+    from .analytic import hertz_pressure
+    plt = pyplot()
+    xs = np.linspace(-1.5 * a_ref_m, 1.5 * a_ref_m, 400)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(xs * 1e3, [hertz_pressure(xi, a_ref_m, p0_ref_Pa) / 1e6 for xi in xs], "k-",
+            label=ref_label)
+    ax.plot(np.asarray(x_m) * 1e3, np.asarray(p_Pa) / 1e6, "o", ms=4, label=label)
+    for xe, ye, marker, lab in extra:
+        ax.plot(np.asarray(xe) * 1e3, np.asarray(ye) / 1e6, marker, ms=3, label=lab)
+    ax.set_xlim(-1.5 * a_ref_m * 1e3, 1.5 * a_ref_m * 1e3)
+    ax.set_xlabel("x [mm]")
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
