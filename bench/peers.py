@@ -36,6 +36,7 @@ import peers_flexcontact as pf  # noqa: E402
 import peers_getfem as pg  # noqa: E402
 import peers_snes as ps  # noqa: E402
 from peers_cases import MU_FRICTION, agreement, build_case, measure  # noqa: E402
+from flexcontact.info import describe  # noqa: E402
 
 INCREMENTS = 20
 # (dim, kind, refine, loadings): the 3D Hertz mesh at about 60k DOFs (hertz3d --refine 1);
@@ -97,11 +98,8 @@ def run_case(dim: int, kind: str, refine: int, loadings) -> dict:
 
 
 def machine() -> dict:
-    import dolfinx
-    import petsc4py
-    info = {"python": platform.python_version(), "platform": platform.platform(),
-            "dolfinx": dolfinx.__version__, "petsc4py": petsc4py.__version__,
-            "processor": platform.processor()}
+    """flexcontact.info's record of the stack, plus the processor and GetFEM's version."""
+    info = dict(describe(), processor=platform.processor())
     if pg.available():
         info["getfem"] = getattr(pg.gf, "__version__", "5.4 (Debian python3-getfem)")
     return info
