@@ -95,6 +95,21 @@ def test_not_converging_is_reported(setup):
     assert problem.increments == []
 
 
+def test_spent_time_budget_is_reported(setup):
+    """A chain whose time budget is spent stops trying and says so in the error."""
+    opts = fc.SolverOptions(time_budget_s=1e-9)
+    problem, (ux, uy) = _problem(setup, solver=opts)
+    uy.value = -1e-6
+    with pytest.raises(fc.ConvergenceError, match=r"time budget of 1e-09 s spent"):
+        problem.step()
+    assert problem.increments == []
+
+
+def test_bad_time_budget_is_named():
+    with pytest.raises(ValueError, match=r"time_budget_s = -1\.0+; it must be 0"):
+        fc.SolverOptions(time_budget_s=-1.0)
+
+
 def test_bad_increment_count(setup):
     problem, _ = _problem(setup)
     with pytest.raises(ValueError, match="increments"):

@@ -16,6 +16,8 @@
 #include <pybind11/stl.h>
 
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace py = pybind11;
 using namespace flexcontact;
@@ -158,21 +160,30 @@ void flexcontact::bind_kernel(py::module& m)
       .def(py::init<>())
       .def(py::init(
                [](double tolerance, int max_iterations, std::vector<std::string> chain,
-                  bool verbose)
+                  bool verbose, double time_budget_s)
                {
+                 if (!(time_budget_s >= 0.0))
+                   throw std::invalid_argument("SolverOptions: time_budget_s = "
+                                               + std::to_string(time_budget_s)
+                                               + "; it must be 0 (automatic) or positive");
                  SolverOptions o;
                  o.tolerance = tolerance;
                  o.max_iterations = max_iterations;
                  o.chain = std::move(chain);
                  o.verbose = verbose;
+                 o.time_budget_s = time_budget_s;
                  return o;
                }),
            py::arg("tolerance") = 1e-10, py::arg("max_iterations") = 100,
-           py::arg("chain") = std::vector<std::string>(), py::arg("verbose") = false)
+           py::arg("chain") = std::vector<std::string>(), py::arg("verbose") = false,
+           py::arg("time_budget_s") = 0.0)
       .def_readwrite("tolerance", &SolverOptions::tolerance)
       .def_readwrite("max_iterations", &SolverOptions::max_iterations)
       .def_readwrite("chain", &SolverOptions::chain)
       .def_readwrite("verbose", &SolverOptions::verbose)
+      .def_readwrite("time_budget_s", &SolverOptions::time_budget_s,
+                     "Wall-clock limit (s): a solver alone stops at it (0: none); the chain "
+                     "shares it among its attempts (0: chain_time_budget_s(n))")
       .def("__repr__",
            [](const SolverOptions& o)
            {
@@ -181,7 +192,8 @@ void flexcontact::bind_kernel(py::module& m)
                << ", max_iterations=" << o.max_iterations << ", chain=[";
              for (std::size_t i = 0; i < o.chain.size(); ++i)
                s << (i ? ", " : "") << "'" << o.chain[i] << "'";
-             s << "], verbose=" << (o.verbose ? "True" : "False") << ")";
+             s << "], verbose=" << (o.verbose ? "True" : "False")
+               << ", time_budget_s=" << o.time_budget_s << ")";
              return s.str();
            });
 
@@ -346,6 +358,9 @@ void flexcontact::bind_kernel(py::module& m)
 
   m.def("solver_names", &solver_names, "Names accepted in SolverOptions.chain");
   m.def("default_chain", &default_chain, "Default solver order, most robust first");
+  m.def("chain_time_budget_s", &chain_time_budget_s, py::arg("n"),
+        "The chain's wall-clock budget (s) for n unknowns when time_budget_s is 0: "
+        "3 + 10 (n/1000)^3");
 
   // ---- increment.hpp -------------------------------------------------------------------
   py::class_<IncrementalSolver>(m, "IncrementalSolver",

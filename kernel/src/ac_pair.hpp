@@ -7,12 +7,43 @@
 
 #include "flexcontact/problem.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace flexcontact::detail
 {
+/// @brief The wall-clock limit of SolverOptions::time_budget_s, started at construction;
+/// a budget of 0 (or less) never passes.
+class Deadline
+{
+public:
+  explicit Deadline(double budget_s)
+      : limited_{budget_s > 0.0},
+        end_{std::chrono::steady_clock::now()
+             + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                 std::chrono::duration<double>(limited_ ? budget_s : 0.0))}
+  {
+  }
+
+  bool passed() const { return limited_ && std::chrono::steady_clock::now() >= end_; }
+
+  /// @brief Seconds left (a large number when unlimited, 0 once passed).
+  double left_s() const
+  {
+    if (!limited_)
+      return 1e300;
+    const std::chrono::duration<double> left = end_ - std::chrono::steady_clock::now();
+    return std::max(left.count(), 0.0);
+  }
+
+private:
+  bool limited_;
+  std::chrono::steady_clock::time_point end_;
+};
+
 /// @brief Alart–Curnier function of one pair, Φ = λ − P(λ − ρ u) in the non-De Saxcé form:
 /// normal λ_n − max(0, z_n); tangent λ_t − P_disc(μ max(0, z_n))(z_t), z = λ − ρ u.
 /// If dP is non-null it receives ∂P/∂z (d×d, row-major), one element of the generalised
@@ -101,6 +132,15 @@ struct NewtonSettings
   bool block_rho = false;
   /// Newton steps allowed: this × SolverOptions::max_iterations.
   int iteration_factor = 1;
+  /// Siconos' globalisation instead of Gauss–Seidel restarts: where the line search finds
+  /// no decrease, the full Newton step is taken anyway, and a slow iteration is never
+  /// restarted. Non-monotone, it crosses the kinks of Φ that trap a monotone search on
+  /// ill-conditioned W (condition 1e10), where it needs hundreds of steps.
+  bool full_step = false;
+  /// With full_step, a Goldstein–Price search (accept α when the merit's mean slope lies
+  /// between 0.99 and 0.01 of the initial one, bisecting between the bounds) instead of
+  /// Armijo backtracking. Neither solves all the ill-conditioned problems the other does.
+  bool goldstein_price = false;
 };
 
 /// @brief The Newton of solve_newton_ac() with the given settings (newton_ac.cpp).

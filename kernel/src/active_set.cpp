@@ -8,6 +8,8 @@
 #include "flexcontact/residual.hpp"
 #include "flexcontact/solvers.hpp"
 
+#include "ac_pair.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -379,7 +381,8 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
 
   Matrix A(n, n);
   Vector b(n), x(n);
-  while (rep.iterations < opt.max_iterations)
+  const detail::Deadline deadline(opt.time_budget_s);
+  while (rep.iterations < opt.max_iterations && !deadline.passed())
   {
     build_modified_system(p, states, dir, c, A, b);
     ++rep.iterations;

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -177,30 +178,58 @@ struct Trial
   Vector lam, u, phi, Wdl;
 };
 
+/// @brief The merit ½‖Φ‖² at λ + α Δ (filling t); +inf if not finite.
+double trial_merit(const ProblemView& p, const Vector& rho, const Vector& rho_t,
+                   const Vector& lam, const Vector& u, const Vector& dl, double alpha, Trial& t)
+{
+  t.lam = lam + alpha * dl;
+  t.u = u + alpha * t.Wdl;
+  ac_all(p, rho, rho_t, t.lam, t.u, t.phi, nullptr);
+  const double ft = 0.5 * t.phi.squaredNorm();
+  return std::isfinite(ft) ? ft : std::numeric_limits<double>::infinity();
+}
+
 /// @brief Line search on ½‖Φ‖², Armijo with the non-monotone reference of history. If the
 /// Newton direction dl gives no decrease, the fixed-point direction −Φ (a projected step)
-/// replaces it. Returns true with the accepted iterate in t.
+/// replaces it (not with full_step, where the caller then takes the full Newton step).
+/// Returns true with the accepted iterate in t.
 bool line_search(const ProblemView& p, const Vector& rho, const Vector& rho_t,
                  const Vector& lam, const Vector& u, const Vector& phi, double f,
-                 const MeritHistory& history, Vector& dl, Trial& t)
+                 const MeritHistory& history, bool full_step, Vector& dl, Trial& t)
 {
   constexpr double sigma = 1e-4;
-  const double fref = history.reference();
-  for (int attempt = 0; attempt < 2; ++attempt)
+  const double fref = full_step ? f : history.reference();
+  for (int attempt = 0; attempt < (full_step ? 1 : 2); ++attempt)
   {
     if (attempt == 1)
       dl = -phi;
     t.Wdl.noalias() = p.W * dl;
     double alpha = 1.0;
     for (int ls = 0; ls < 40; ++ls, alpha *= 0.5)
-    {
-      t.lam = lam + alpha * dl;
-      t.u = u + alpha * t.Wdl;
-      ac_all(p, rho, rho_t, t.lam, t.u, t.phi, nullptr);
-      const double ft = 0.5 * t.phi.squaredNorm();
-      if (std::isfinite(ft) && ft <= fref - 2.0 * sigma * alpha * f)
+      if (trial_merit(p, rho, rho_t, lam, u, dl, alpha, t) <= fref - 2.0 * sigma * alpha * f)
         return true;
-    }
+  }
+  return false;
+}
+
+/// @brief Goldstein–Price search along the Newton direction (the merit's slope there is
+/// −2f): α is accepted when the mean slope (f(α) − f)/α lies between 0.99 and 0.01 times
+/// the initial one; too steep raises the lower bound, too shallow lowers the upper, and
+/// α bisects the bracket. Returns true with the accepted iterate in t.
+bool goldstein_price(const ProblemView& p, const Vector& rho, const Vector& rho_t,
+                     const Vector& lam, const Vector& u, double f, const Vector& dl, Trial& t)
+{
+  const double slope0 = -2.0 * f;
+  t.Wdl.noalias() = p.W * dl;
+  double lo = 0.0, hi = 1e10, alpha = 1.0;
+  for (int ls = 0; ls < 100; ++ls)
+  {
+    const double slope = (trial_merit(p, rho, rho_t, lam, u, dl, alpha, t) - f) / alpha;
+    const bool not_too_steep = slope >= 0.99 * slope0;
+    if (not_too_steep && slope <= 0.01 * slope0)
+      return true;
+    (not_too_steep ? hi : lo) = alpha;
+    alpha = 0.5 * (lo + hi);
   }
   return false;
 }
@@ -271,13 +300,20 @@ SolveReport detail::newton_ac(const ProblemView& p, const Eigen::Ref<const Vecto
   double res = natural_map_residual(p, lam, u, rho_res);
   int it = 0;
   std::string why;
-  int last_gain = 0, sweeps_used = 0;
-  double best = res;
+  int last_gain = 0, sweeps_used = 0, full_steps = 0;
+  double gain_ref = res, best = res;
+  Vector best_lam = lam;
   // Iterations without halving the residual before Newton is declared stalled.
   constexpr int stall = 8;
   MeritHistory history(f);
+  const detail::Deadline deadline(opt.time_budget_s);
   while (res > opt.tolerance && it < maxit)
   {
+    if (deadline.passed())
+    {
+      why = ", time budget spent";
+      break;
+    }
     ++it;
     closed_pairs(dP, m, d, closed);
     if (!newton_direction(p, rho, rho_t, phi, dP, closed, dl))
@@ -285,8 +321,19 @@ SolveReport detail::newton_ac(const ProblemView& p, const Eigen::Ref<const Vecto
       why = ", linear system not solvable";
       break;
     }
-    const bool accepted = line_search(p, rho, rho_t, lam, u, phi, f, history, dl, trial);
-    if (!accepted || it - last_gain >= stall)
+    bool accepted = settings.full_step && settings.goldstein_price
+                        ? goldstein_price(p, rho, rho_t, lam, u, f, dl, trial)
+                        : line_search(p, rho, rho_t, lam, u, phi, f, history,
+                                      settings.full_step, dl, trial);
+    if (!accepted && settings.full_step)
+    {
+      // Siconos' rule: no decrease along the Newton direction, take the full step anyway.
+      ++full_steps;
+      trial.lam = lam + dl;
+      trial.u.noalias() = p.W * trial.lam + p.q;
+      accepted = trial.lam.allFinite();
+    }
+    if (!accepted || (!settings.full_step && it - last_gain >= stall))
     {
       // Stalled: the sweeps move λ to where Newton converges fast again.
       ++sweeps_used;
@@ -299,7 +346,12 @@ SolveReport detail::newton_ac(const ProblemView& p, const Eigen::Ref<const Vecto
       f = merit(p, rho, rho_t, lam, u, phi, dP);
       history.reset(f);
       last_gain = it;
-      best = std::min(best, res);
+      gain_ref = std::min(gain_ref, res);
+      if (res < best)
+      {
+        best = res;
+        best_lam = lam;
+      }
       if (opt.verbose)
         std::fprintf(stderr, "newton_ac it %d: Gauss-Seidel sweeps, residual %.3e\n", it, res);
       continue;
@@ -313,15 +365,25 @@ SolveReport detail::newton_ac(const ProblemView& p, const Eigen::Ref<const Vecto
     f = merit(p, rho, rho_t, lam, u, phi, dP);
     history.push(f);
     res = natural_map_residual(p, lam, u, rho_res);
-    if (res < 0.5 * best)
+    if (res < 0.5 * gain_ref)
+    {
+      gain_ref = res;
+      last_gain = it;
+    }
+    if (res < best)
     {
       best = res;
-      last_gain = it;
+      best_lam = lam;
     }
     if (opt.verbose)
       std::fprintf(stderr, "newton_ac it %d: closed %d, merit %.3e, residual %.3e\n", it,
                    static_cast<int>(closed.size()), f, res);
   }
+  if (full_steps > 0)
+    why += ", full steps " + std::to_string(full_steps);
+  // Full steps make the iteration non-monotone: report the best iterate met.
+  if (settings.full_step && !(res <= opt.tolerance) && best < res)
+    lam = best_lam;
 
   finish_report(p, lam, it, sweeps_used, why, opt.tolerance, rep);
   return rep;

@@ -282,8 +282,14 @@ SolveReport solve_projection(const ProblemView& p, const Eigen::Ref<const Vector
   long sweep = 0;
   int fallbacks = 0;
   std::string why;
+  const detail::Deadline deadline(opt.time_budget_s);
   while (res > opt.tolerance && sweep < max_sweeps)
   {
+    if (deadline.passed())
+    {
+      why = ", time budget spent";
+      break;
+    }
     ++sweep;
     fallbacks += detail::nsgs_sweep(p, rho, lam, u);
     if (!lam.allFinite())

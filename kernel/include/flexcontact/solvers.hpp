@@ -69,10 +69,15 @@ std::vector<std::string> default_chain();
 /// then needs a step or two. Each solver is tried from the best answer so far and from the
 /// caller's start (the active set from the caller's first). Newton from the caller's start
 /// gets 10 × max_iterations steps (ill-conditioned problems need hundreds of damped ones);
-/// if it fails, Newton runs once more from zero with each pair's ρ = 1/‖W_kk‖₂ (Siconos'
-/// NSN_AC scaling), which solves a different subset of the hard problems. The report is the
-/// converging solver's, with `attempts` listing every try; if none converges it is the best
-/// one's (smallest residual) with converged=false.
+/// if it fails, Newton runs from zero in four more variants, each 10 × max_iterations
+/// steps: Siconos' globalisation (full step where the line search fails) with each pair's
+/// ρ = 1/‖W_kk‖₂ and a Goldstein–Price search, the same with Armijo's search, Armijo's
+/// with the normal/tangential ρ, and the restarted Newton with the block ρ; they solve
+/// different subsets of the hard problems. The whole chain stops trying once opt.time_budget_s (0:
+/// chain_time_budget_s(n), 3 s + 10 s·(n/1000)³) has passed, with a line in `attempts`;
+/// each attempt also stops at it. The report is the converging solver's, with `attempts`
+/// listing every try; if none converges it is the best one's (smallest residual) with
+/// converged=false.
 SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                   const std::vector<PairState>& states0, const SolverOptions& opt);
 } // namespace flexcontact
