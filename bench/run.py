@@ -119,9 +119,13 @@ def _wait(child: subprocess.Popen, timeout_s: float):
         time.sleep(0.2)
 
 
-def run_mpi(names: list[str], args) -> dict:
-    """Each case serial then with ``mpirun -n 2``, back to back; speed-ups and answers."""
-    rows = []
+def run_mpi(names: list[str], args, save=lambda section: None) -> dict:
+    """Each case serial then with ``mpirun -n 2``, back to back; speed-ups and answers.
+    ``save(section)`` is called after each case (a long run leaves its results on the way)."""
+    ceiling = HERE / "mpi_ceiling.json"
+    section = {"cases": [],
+               "ceiling": json.loads(ceiling.read_text()) if ceiling.exists() else None}
+    rows = section["cases"]
     for name in names:
         runs, answers = {}, {}
         for ranks in (1, 2):
@@ -135,9 +139,8 @@ def run_mpi(names: list[str], args) -> dict:
         row = report.mpi_compare(runs[1], runs[2], answers.get(1), answers.get(2))
         print("  " + report.mpi_line(row), flush=True)
         rows.append(row)
-    ceiling = HERE / "mpi_ceiling.json"
-    return {"cases": rows,
-            "ceiling": json.loads(ceiling.read_text()) if ceiling.exists() else None}
+        save(section)
+    return section
 
 
 def run_peers(args) -> dict:
@@ -191,7 +194,10 @@ def main(argv=None):
         print("  " + report.one_line(case), flush=True)
         write(results, args.out, t0)
     if args.mpi or args.mpi_only:
-        results["mpi"] = run_mpi(args.mpi_cases, args)
+        def save(section):
+            results["mpi"] = section
+            write(results, args.out, t0)
+        results["mpi"] = run_mpi(args.mpi_cases, args, save)
     if args.peers:
         results["peers"] = run_peers(args)
     write(results, args.out, t0)
