@@ -78,9 +78,8 @@ def memory_phase(out: dict):
     out["peak_mb"] = _status_kb("VmHWM") / 1024
 
 
-def model(spec: dict) -> dict:
+def model(spec: dict, comm=MPI.COMM_SELF) -> dict:
     """Mesh, form, Dirichlet conditions and the contact interface of a Hertz case."""
-    comm = MPI.COMM_SELF
     dim = 2 if spec["mesh"] == "hertz2d" else 3
     builder = hertz2d if dim == 2 else hertz3d
     t0 = time.perf_counter()
@@ -118,6 +117,7 @@ def compiled_form(a):
 def linear_phase(m: dict, repeat: int) -> dict:
     """One plain linear-elastic solve: assembly, factorization (a), back-substitution (d)."""
     out = {}
+    comm = m["V"].mesh.comm
     a_form = compiled_form(m["a"])
     with memory_phase(out):
         t0 = time.perf_counter()
@@ -128,7 +128,7 @@ def linear_phase(m: dict, repeat: int) -> dict:
         out["factorization_call_s"] = time.perf_counter() - t0
         m["approach"](m["delta_m"])
         t0 = time.perf_counter()
-        p = assemble_load(m["V"], a_form, None, m["bcs"], MPI.COMM_SELF)
+        p = assemble_load(m["V"], a_form, None, m["bcs"], comm)
         out["load_s"] = time.perf_counter() - t0
         x = K.createVecRight()
         t0 = time.perf_counter()
@@ -164,7 +164,7 @@ def contact_phase(m: dict, increments: int, repeat: int) -> dict:
             inc = problem.step()
             s = inc.summary
             rows.append({"increment_s": time.perf_counter() - t0,
-                         "contact_solve_s": problem.timings["last_contact_step_s"],
+                         "contact_solve_s": problem.timings.get("last_contact_step_s", 0.0),
                          "solver": s.solver, "iterations": s.iterations,
                          "residual": s.residual, "closed_pairs": s.stick + s.slip,
                          "normal_force": s.normal_force})
@@ -186,9 +186,32 @@ def contact_phase(m: dict, increments: int, repeat: int) -> dict:
     out["increment_s"] = float(np.median([r["increment_s"] for r in later]))
     out["contact_solve_s"] = float(np.median([r["contact_solve_s"] for r in later]))
     out["first_increment_s"] = rows[0]["increment_s"]
+    if m.get("answer_file"):
+        write_answer(problem, rows, m["answer_file"])
     for v in (b, x):
         v.destroy()
     return out
+
+
+def write_answer(problem, rows: list, path: str) -> None:
+    """The answer, to compare runs on different numbers of ranks (bench/run.py --mpi): the
+    normal force of each increment, u and the contact pressure at every node, nodes sorted
+    by position (the bodies' touching node: then by value), gathered on rank 0."""
+    comm, dim = problem.comm, problem.dim
+    V, Q = problem.u.function_space, problem.pressure.function_space
+    nu, nq = V.dofmap.index_map.size_local, Q.dofmap.index_map.size_local
+    parts = comm.gather((V.tabulate_dof_coordinates()[:nu, :dim],
+                         problem.u.x.array[:dim * nu].reshape(-1, dim),
+                         Q.tabulate_dof_coordinates()[:nq, :dim],
+                         problem.pressure.x.array[:nq]))
+    if comm.rank != 0:
+        return
+    xu, u, xp, p = (np.concatenate([q[k] for q in parts]) for k in range(4))
+    xu, xp = np.round(xu, 9), np.round(xp, 9)  # [m]: meshes on 1 or 2 ranks differ in the last bits
+    ou = np.lexsort((u[:, -1], *xu.T[::-1]))
+    op = np.lexsort((p, *xp.T[::-1]))
+    np.savez(path, u=u[ou], pressure=p[op],
+             normal_force=[r["normal_force"] for r in rows])
 
 
 def main():
@@ -197,17 +220,21 @@ def main():
     ap.add_argument("--spec", required=True, help="the case as JSON (bench/run.py's CASES)")
     args = ap.parse_args()
     spec = json.loads(args.spec)
-    m = model(spec)
+    comm = MPI.COMM_WORLD  # one process, or the ranks of bench/run.py --mpi
+    m = model(spec, comm)
+    m["answer_file"] = spec.get("answer_file")
     compiled_form(m["a"])  # the form compiler runs before any timing
     increments, repeat = spec.get("increments", 4), spec.get("repeat", 5)
     result = {"name": spec["name"], "spec": spec, "dim": m["dim"], "dofs": m["dofs"],
+              "ranks": comm.size,
               "mu": m["mu"], "mesh_s": m["mesh_s"],
               "contact_nodes_per_surface": m["contact_nodes_per_surface"]}
     result["linear"] = linear_phase(m, repeat)
     result["contact"] = contact_phase(m, increments, repeat)
     result["system"] = describe()  # the libraries this process actually loaded
     result["loaded_libraries"] = loaded_libraries()
-    print("RESULT " + json.dumps(result), flush=True)
+    if comm.rank == 0:
+        print("RESULT " + json.dumps(result), flush=True)
 
 
 def loaded_libraries() -> list[str]:

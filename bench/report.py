@@ -68,6 +68,116 @@ def targets(cases: list[dict]) -> list[dict]:
     return rows
 
 
+# ---- serial against mpirun -n 2 (bench/run.py --mpi) -------------------------------------
+MPI_PHASES = [("factorization (a)", "linear", "factorization_s"),
+              ("F* (factorization with Schur complement, F*)", "contact", "flexibility_s"),
+              ("F* + W (b)", "contact", "fstar_w_s"),
+              ("increment (c)", "contact", "increment_s"),
+              ("back-substitution (d)", "contact", "backsolve_s"),
+              ("set-up", "contact", "setup_s")]
+
+
+def _max_rel(a, b) -> float | None:
+    """max |a − b| / max |b| (None if either is missing or the shapes differ)."""
+    import numpy as np
+    if a is None or b is None:
+        return None
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if a.shape != b.shape or not b.size:
+        return None
+    return float(np.max(np.abs(a - b)) / max(np.max(np.abs(b)), 1e-300))
+
+
+def mpi_compare(serial: dict, par: dict, ans1: dict | None, ans2: dict | None) -> dict:
+    """Per phase the serial and two-rank times and the speed-up; the answers' differences."""
+    row = {"name": serial.get("name", par.get("name")), "serial": serial, "np2": par}
+    if "error" in serial or "error" in par:
+        row["error"] = serial.get("error") or par.get("error")
+        return row
+    row.update(dofs=serial["dofs"], dim=serial["dim"],
+               contact_dofs=serial["contact"]["contact_dofs"], phases=[])
+    for label, part, key in MPI_PHASES:
+        t1, t2 = serial[part][key], par[part][key]
+        row["phases"].append({"phase": label, "key": key, "serial_s": t1, "np2_s": t2,
+                              "speedup": t1 / t2 if t2 else None})
+    row["wall_speedup"] = serial["wall_s"] / par["wall_s"]
+    a1, a2 = ans1 or {}, ans2 or {}
+    row["max_rel_diff"] = {k: _max_rel(a2.get(k), a1.get(k))
+                           for k in ("u", "pressure", "normal_force")}
+    row["load_average"] = {"serial": serial.get("load_average"),
+                           "np2": par.get("load_average")}
+    row["mumps_ordering"] = {"serial": serial["contact"]["mumps_ordering"],
+                             "np2": par["contact"]["mumps_ordering"]}
+    return row
+
+
+def mpi_line(r: dict) -> str:
+    if "error" in r:
+        return f"{r['name']}: {r['error']}"
+    sp = " ".join(f"{p['key']} ×{_f(p['speedup'])}" for p in r["phases"])
+    d = r["max_rel_diff"]
+    return f"{r['name']}: {sp}; max rel diff u {_e(d['u'])} p {_e(d['pressure'])}"
+
+
+def _e(v):
+    return "—" if v is None else f"{v:.1e}"
+
+
+def _ceiling_lines(c: dict | None) -> list[str]:
+    if not c:
+        return ["(bench/mpi_ceiling.json not found: run bench/mpi_ceiling.py for the ceiling)"]
+    d = c["dgemm"]
+    out = [f"The machine's ceiling (bench/mpi_ceiling.py, {c['started_utc']} UTC, load "
+           f"average {c['load_average_at_start'][0]:.1f} at its start): one dgemm "
+           f"(n = {c['dgemm_n']}) alone against two at once, 2 × t_alone / t_pair = "
+           + ", ".join(_f(x["ceiling"]) for x in d) + " (best "
+           + _f(c.get("ceiling", max(x["ceiling"] for x in d))) + ").", ""]
+    for mesh, rounds in c.get("factorization", {}).items():
+        for r in rounds:
+            serial, par = r["np1"]["variants"], r["np2"]["variants"]
+            ok = [k for k in par if _factored(serial[k]) and _factored(par[k])]
+            out.append(f"* MUMPS factorization alone, {mesh} ({r['np1']['dofs']:,} DOFs), "
+                       "serial → 2 ranks s (speed-up): "
+                       + ", ".join(f"{k} {serial[k]['s']:.2f} → {par[k]['s']:.2f} "
+                                   f"(×{serial[k]['s'] / par[k]['s']:.2f})" for k in ok)
+                       + "".join(f"; {k}: no factor on 2 ranks" for k in par if k not in ok))
+    return out + [""]
+
+
+def _factored(row: dict) -> bool:
+    """bench/mpi_ceiling.py's row made a factor (no INFOG(1) < 0, entries in it)."""
+    return row.get("infog1", 0) >= 0 and row.get("factor_entries", 0) != 0
+
+
+def mpi_section(m: dict | None) -> list[str]:
+    if not m:
+        return []
+    out = ["## Serial against `mpirun -n 2` (issue 18, item 5)", "",
+           "The largest 2D and 3D cases of the default set, on one process and on two "
+           "(`bench/run.py --mpi`), back to back. Speed-up = serial time / two-rank time; "
+           "answers: max |u₂ − u₁| / max |u₁| over all nodes (likewise the contact pressure "
+           "and each increment's normal force).", "",
+           *_ceiling_lines(m.get("ceiling")),
+           "| case | phase | serial s | 2 ranks s | speed-up |", "|---|---|---:|---:|---:|"]
+    for r in m["cases"]:
+        if "error" in r:
+            out.append(f"| {r['name']} | failed: {r['error']} | | | |")
+            continue
+        for p in r["phases"]:
+            out.append(f"| {r['name']} | {p['phase']} | {_f(p['serial_s'], 3)} | "
+                       f"{_f(p['np2_s'], 3)} | {_f(p['speedup'])} |")
+    out += ["", "| case | whole case speed-up | max rel. diff. u | pressure | normal force | "
+            "load average serial / 2 ranks |", "|---|---:|---:|---:|---:|---|"]
+    for r in m["cases"]:
+        if "error" in r:
+            continue
+        d, la = r["max_rel_diff"], r["load_average"]
+        out.append(f"| {r['name']} | {_f(r['wall_speedup'])} | {_e(d['u'])} | "
+                   f"{_e(d['pressure'])} | {_e(d['normal_force'])} | "
+                   f"{_f((la['serial'] or [None])[0], 1)} / {_f((la['np2'] or [None])[0], 1)} |")
+    return out + [""]
+
+
 def _f(v, digits=2):
     return "—" if v is None else f"{v:.{digits}f}"
 
@@ -230,6 +340,7 @@ def markdown(res: dict) -> str:
     why = _why(res.get("targets", []), res["cases"])
     if why:
         lines += ["Where each miss comes from (same run):", "", *why, ""]
+    lines += mpi_section(res.get("mpi"))
     if res.get("notes"):
         lines += ["## Notes", "", *res["notes"], ""]
     failed = [c for c in res["cases"] if "error" in c]

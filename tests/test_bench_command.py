@@ -48,3 +48,22 @@ def test_bench_command_tiny(tmp_path):
     assert len(forces) == 4 and all(b > a > 0 for a, b in zip(forces, forces[1:]))
     assert all(r["residual"] < 1e-8 for r in con["increments"])
     assert case["linear"]["ordering"] == con["ordering"]  # the same ordering for (a) and (b)
+
+
+def test_bench_mpi_section_tiny(tmp_path):
+    """`--mpi-only` on the tiny 2D case: serial and `mpirun -n 2` give the same answer (u and
+    pressure at every node, the normal forces) to round-off; the speed-ups are the
+    quotients of the recorded phase times."""
+    run = _run_module()
+    run.main(["--mpi-only", "--mpi-cases", "2d_tiny", "--out", str(tmp_path)])
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["cases"] == []
+    (row,) = res["mpi"]["cases"]
+    assert "error" not in row, row.get("error")
+    assert row["serial"]["ranks"] == 1 and row["np2"]["ranks"] == 2
+    assert row["np2"]["contact"]["method"] == "schur"
+    for key in ("u", "pressure", "normal_force"):
+        assert row["max_rel_diff"][key] is not None and row["max_rel_diff"][key] < 1e-10, key
+    for p in row["phases"]:
+        assert math.isclose(p["speedup"], p["serial_s"] / p["np2_s"], rel_tol=1e-12)
+    assert "Serial against `mpirun -n 2`" in (tmp_path / "RESULTS.md").read_text()

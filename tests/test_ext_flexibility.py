@@ -3,7 +3,7 @@
 Checked against a dense inverse of K on small meshes, the Schur and selected-inverse
 (MUMPS ICNTL(30)) paths against the multi-right-hand-side path, the returned factor against
 a dense solve, singular stiffness and bad input as Python exceptions, and serial against
-`mpirun -n 2` (where the default "schur" becomes "inverse_entries", still one factorization).
+`mpirun -n 2` (where the default "schur" drives MUMPS directly: tests/test_mpi_schur.py).
 Run as a script (under mpirun) it writes F* of every method to the file given.
 """
 import shutil
@@ -195,7 +195,7 @@ def _write_flexibility(path):
         for method in METHODS:
             F, factor, info = fc.flexibility(K, dofs, method)
             out[f"{method}_{dim}"] = F
-            # One sparse factorization always; in parallel "schur" runs as "inverse_entries".
+            # One sparse factorization always, on one rank or two.
             out[f"{method}_{dim}_factorizations"] = np.array(info["factorizations"])
             out[f"{method}_{dim}_used"] = np.array(info["method"])
             # the returned factor solves with K in parallel too
@@ -228,7 +228,7 @@ def test_two_ranks_match_serial(tmp_path):
             assert rel(par[f"{method}_{dim}"], F) < 1e-10
             assert float(par[f"{method}_{dim}_residual"]) < 1e-10
             assert int(par[f"{method}_{dim}_factorizations"]) == 1
-        assert str(par[f"schur_{dim}_used"]) == "inverse_entries"
+        assert str(par[f"schur_{dim}_used"]) == "schur"
         assert rel(par[f"inverse_entries_{dim}"], par[f"matmatsolve_{dim}"]) < 1e-10
 
 

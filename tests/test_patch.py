@@ -39,7 +39,7 @@ from flexcontact.meshes import patch, surface_nodes, tags
 COMM = MPI.COMM_WORLD
 ROUNDOFF = 1e-10       # relative; exact method, measured ≤ 1e-14 (see the module docstring)
 SLIP_ROUNDOFF = 1e-9   # relative to the largest exact slip; measured ≤ 1e-14
-MPI_ROUNDOFF = 1e-10   # serial vs 2 ranks (other flexibility path: MUMPS inverse entries)
+MPI_ROUNDOFF = 1e-10   # serial vs 2 ranks (MUMPS's Schur complement on one rank or two)
 EXACT_CHAINS = [("active_set",), ("newton_ac",)]
 
 _cache = {}

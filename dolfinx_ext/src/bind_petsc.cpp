@@ -7,6 +7,8 @@
 /// the Python layer of DOLFINx 0.9 is built with nanobind, whose objects pybind11 cannot take.
 
 #include "bindings.h"
+#include "collective.h"
+#include "distributed_schur.h"
 #include "flexibility.h"
 #include "petsc_caster.h"
 #include "petsc_error.h"
@@ -17,12 +19,83 @@
 
 namespace py = pybind11;
 
+namespace
+{
+/// @brief u_c (rank 0's n_c values; anything elsewhere) checked on every rank.
+std::vector<double> contact_values(MPI_Comm comm, int n_c, const py::object& u_c)
+{
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::vector<double> v;
+  std::string bad;
+  if (rank == 0)
+  {
+    auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(u_c);
+    if (!a or a.ndim() != 1 or a.shape(0) != n_c)
+      bad = "expand: u_c must hold the " + std::to_string(n_c) + " contact values on rank 0";
+    else
+      v.assign(a.data(), a.data() + n_c);
+  }
+  flexcontact::throw_collective_if(comm, !bad.empty(), bad,
+                                   [](const std::string& w) { throw std::invalid_argument(w); });
+  return v;
+}
+
+void bind_distributed_schur(py::module& m)
+{
+  using flexcontact::DistributedSchur;
+  py::class_<DistributedSchur, std::shared_ptr<DistributedSchur>>(
+      m, "DistributedSchur",
+      R"(K factored by MUMPS on several ranks with a Schur complement on the contact DOFs
+(returned by flexibility(K, dofs, "schur") there). Every method is collective.)")
+      .def_property_readonly("has_condense", [](const DistributedSchur&) { return true; })
+      .def(
+          "solve",
+          [](DistributedSchur& f, Vec b, Vec x)
+          {
+            py::gil_scoped_release release;
+            f.solve(b, x);
+          },
+          py::arg("b"), py::arg("x"), "x = K^-1 b (b, x laid out as K's rows).")
+      .def(
+          "condense",
+          [](DistributedSchur& f, Vec b)
+          {
+            std::vector<double> r;
+            {
+              py::gil_scoped_release release;
+              r = f.condense(b);
+            }
+            return py::array_t<double>(static_cast<py::ssize_t>(r.size()), r.data());
+          },
+          py::arg("b"),
+          "Reduced right-hand side b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order "
+          "given to flexibility, on rank 0 (empty elsewhere).")
+      .def(
+          "expand",
+          [](DistributedSchur& f, const py::object& u_c, Vec x)
+          {
+            MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(x));
+            std::vector<double> v = contact_values(comm, f.n_schur(), u_c);
+            py::gil_scoped_release release;
+            f.expand(v, x);
+          },
+          py::arg("u_c"), py::arg("x"),
+          "x = the solution whose contact values are u_c (rank 0), for the right-hand side "
+          "of the last condense().")
+      .def("destroy", &DistributedSchur::release,
+           "Free the MUMPS instance now (otherwise when the object goes).");
+}
+} // namespace
+
 void flexcontact::bind_petsc(py::module& m)
 {
   py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError",
                                                  PyExc_RuntimeError);
   py::register_exception<MumpsError>(m, "MumpsError", PyExc_RuntimeError);
   py::register_exception<PetscError>(m, "PetscError", PyExc_RuntimeError);
+
+  bind_distributed_schur(m);
 
   m.def(
       "flexibility",
@@ -55,7 +128,9 @@ void flexcontact::bind_petsc(py::module& m)
         info["n_blocks"] = r.n_blocks;
         info["block_sizes"] = r.block_sizes;
         info["blocks_s"] = r.blocks_s;
-        py::object factor = py::cast(r.factor, py::return_value_policy::take_ownership);
+        py::object factor = r.distributed
+                                ? py::cast(r.distributed)
+                                : py::cast(r.factor, py::return_value_policy::take_ownership);
         py::array_t<double> F = py::cast(r.F);
         return py::make_tuple(F, factor, info);
       },
@@ -68,18 +143,20 @@ Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); cont
 complement K*_cc inside the factorization, then F* = inv(K*_cc) by dense Cholesky),
 "inverse_entries" (MUMPS computes the requested entries of inv(K), ICNTL(30)) or
 "matmatsolve" (solve K X = E_c for the contact unit vectors). PETSc cannot solve with a
-Schur factor in parallel, so there "schur" runs as "inverse_entries"; info["method"] tells.
+Schur factor in parallel, so there "schur" drives MUMPS directly (DistributedSchur).
 ordering: MUMPS's fill-reducing ordering, "auto" (the default: "metis" for K of block size
 3, 3D elasticity; "mumps" otherwise), "metis" (METIS nested dissection of the nodal graph
 handed to MUMPS), "mumps" (MUMPS's automatic choice; Debian's MUMPS has AMD, AMF, PORD,
-QAMD), or one of "amd", "amf", "pord", "qamd"; on several ranks MUMPS's automatic choice is
-used (info["ordering"] tells the one asked of MUMPS, "auto" resolved).
+QAMD), or one of "amd", "amf", "pord", "qamd"; on several ranks the methods other than
+"schur" use MUMPS's automatic choice (info["ordering"] tells the one asked of MUMPS, "auto"
+resolved).
 per_body (default True): the contact DOFs that K's graph connects form a block (one per body
 touching contact); F* is block-diagonal by them and only the blocks are computed ("schur":
 each block of K*_cc inverted on its own; "inverse_entries": only entries within blocks asked
 of MUMPS). False: one block of all contact DOFs (the same F* up to rounding).
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
-factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; info:
+factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made (a
+petsc4py Mat, or on several ranks with "schur" a DistributedSchur); info:
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
 workspace), factorization_s,
 schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s, ordering

@@ -1,7 +1,9 @@
 // Copyright flexcontact developers. MIT licence.
 
 #include "flexibility.h"
+#include "collective.h"
 #include "contact_blocks.h"
+#include "distributed_schur.h"
 #include "ordering.h"
 #include "petsc_error.h"
 
@@ -52,22 +54,6 @@ struct OwnedIS
   }
 };
 
-/// @brief Throw on the same condition on every rank: `fail` decided on rank 0 is broadcast.
-void throw_collective_if(MPI_Comm comm, bool fail_on_root, const std::string& what_on_root,
-                         const auto& make)
-{
-  int flag = fail_on_root ? 1 : 0;
-  MPI_Bcast(&flag, 1, MPI_INT, 0, comm);
-  if (!flag)
-    return;
-  int len = static_cast<int>(what_on_root.size());
-  MPI_Bcast(&len, 1, MPI_INT, 0, comm);
-  std::string what = what_on_root;
-  what.resize(len);
-  MPI_Bcast(what.data(), len, MPI_CHAR, 0, comm);
-  make(what);
-}
-
 /// @brief Check MUMPS's global status after a phase; INFOG is the same on every rank.
 void check_mumps(PetscErrorScope& err, Mat F, const char* phase)
 {
@@ -76,14 +62,7 @@ void check_mumps(PetscErrorScope& err, Mat F, const char* phase)
   if (infog1 >= 0)
     return;
   err.check(MatMumpsGetInfog(F, 2, &info2), "MatMumpsGetInfog");
-  std::string what = std::string("MUMPS failed in the ") + phase + ": INFOG(1)=" + std::to_string(infog1)
-                     + ", INFOG(2)=" + std::to_string(info2);
-  if (infog1 == -10)
-    what += " (numerically singular matrix)";
-  else if (infog1 == -9 or infog1 == -8 or infog1 == -13 or infog1 == -19)
-    what += " (not enough memory)";
-  throw MumpsError(what + "; see the MUMPS users' guide, 'Error diagnostics'",
-                   static_cast<int>(infog1));
+  throw_mumps_error(phase, static_cast<int>(infog1), static_cast<int>(info2));
 }
 
 /// @brief Number of null pivots MUMPS found (INFOG(28)), and the singular-K error if any.
@@ -91,13 +70,7 @@ int check_null_pivots(PetscErrorScope& err, Mat F)
 {
   PetscInt n = 0;
   err.check(MatMumpsGetInfog(F, 28, &n), "MatMumpsGetInfog");
-  if (n > 0)
-  {
-    throw SingularStiffnessError(
-        "stiffness matrix is singular: " + std::to_string(n)
-        + " null pivots (a body has rigid-body modes: it is not held by Dirichlet conditions "
-          "or by springs)");
-  }
+  throw_if_null_pivots(static_cast<int>(n));
   return static_cast<int>(n);
 }
 
@@ -507,15 +480,16 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   dofs.resize(n_c);
   MPI_Bcast(dofs.data(), n_c, MPIU_INT, 0, comm);
 
-  // PETSc cannot solve with a Schur-enabled MUMPS factor in parallel, and the returned factor
-  // must serve solves: there, the selected-inverse path gives F* from the one plain factor.
-  const std::string used = (method == "schur" and size > 1) ? "inverse_entries" : method;
+  // PETSc cannot solve with a Schur-enabled MUMPS factor in parallel: there "schur" drives
+  // MUMPS directly (distributed_schur.h), with the same ordering as in serial.
+  const bool direct = method == "schur" and size > 1;
+  const std::string used = method;
 
   Flexibility out;
   out.method = used;
   // A given ordering is set by redoing MUMPS's analysis on rank 0's instance (ordering.h);
-  // on several ranks MUMPS's automatic choice stays.
-  out.ordering = size > 1 ? "mumps" : resolve_ordering(ordering, K);
+  // on several ranks through PETSc MUMPS's automatic choice stays.
+  out.ordering = (size > 1 and !direct) ? "mumps" : resolve_ordering(ordering, K);
   out.ordering_auto = ordering == "auto";
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
@@ -530,7 +504,16 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   for (const auto& b : blocks)
     out.block_sizes.push_back(static_cast<int>(b.size()));
 
-  if (n_c == 0)
+  if (direct)
+  {
+    Flexibility d = distributed_flexibility(K, dofs, out.ordering, blocks);
+    d.ordering_auto = out.ordering_auto;
+    d.n_blocks = out.n_blocks;
+    d.block_sizes = std::move(out.block_sizes);
+    d.blocks_s = out.blocks_s;
+    out = std::move(d);
+  }
+  else if (n_c == 0)
   {
     double t0 = MPI_Wtime();
     out.factor = factorize(err, K, nullptr, out.ordering, out);
@@ -601,4 +584,24 @@ Flexibility flexcontact::factor_analysis(Mat K, std::span<const std::int64_t> co
   F.m = factorize(err, K, dofs.empty() ? nullptr : &dofs, out.ordering, out, true);
   out.factorization_s = MPI_Wtime() - t0;
   return out;
+}
+
+void flexcontact::throw_mumps_error(const char* phase, int infog1, int infog2)
+{
+  std::string what = std::string("MUMPS failed in the ") + phase + ": INFOG(1)="
+                     + std::to_string(infog1) + ", INFOG(2)=" + std::to_string(infog2);
+  if (infog1 == -10)
+    what += " (numerically singular matrix)";
+  else if (infog1 == -9 or infog1 == -8 or infog1 == -13 or infog1 == -19)
+    what += " (not enough memory)";
+  throw MumpsError(what + "; see the MUMPS users' guide, 'Error diagnostics'", infog1);
+}
+
+void flexcontact::throw_if_null_pivots(int n)
+{
+  if (n > 0)
+    throw SingularStiffnessError(
+        "stiffness matrix is singular: " + std::to_string(n)
+        + " null pivots (a body has rigid-body modes: it is not held by Dirichlet conditions "
+          "or by springs)");
 }

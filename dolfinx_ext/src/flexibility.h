@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <memory>
 #include <petscmat.h>
 #include <span>
 #include <stdexcept>
@@ -15,6 +16,8 @@
 
 namespace flexcontact
 {
+class DistributedSchur;
+
 /// @brief K is singular (MUMPS found null pivots, or the condensed stiffness on the contact
 /// DOFs is singular): a body has rigid-body modes that no boundary condition removes.
 class SingularStiffnessError : public std::runtime_error
@@ -41,6 +44,9 @@ struct Flexibility
   /// MUMPS Cholesky factor of K; MatSolve(factor, b, x) gives x = K⁻¹ b. The caller owns
   /// one reference (MatDestroy).
   Mat factor = nullptr;
+  /// "schur" on several ranks: the directly driven MUMPS factor (distributed_schur.h) that
+  /// serves the solves instead of `factor` (then null)
+  std::shared_ptr<DistributedSchur> distributed;
   std::string method;            ///< method actually used: "schur", "inverse_entries" or "matmatsolve"
   int n_contact_dofs = 0;        ///< n_c
   int null_pivots = 0;           ///< MUMPS INFOG(28)
@@ -53,7 +59,7 @@ struct Flexibility
                                  ///< (inverse_entries) or the multi-RHS solve (matmatsolve)
   double inverse_s = 0;          ///< dense Cholesky inversion of K*_cc (schur only)
   std::string ordering;          ///< ordering requested of MUMPS, "auto" resolved ("mumps" on
-                                 ///< several ranks)
+                                 ///< several ranks but for "schur")
   std::string mumps_ordering;    ///< ordering MUMPS used, from INFOG(7) ("metis" for ours)
   bool ordering_auto = false;    ///< "auto" was asked: MUMPS's own choice if ours cannot be set
   std::string ordering_fallback; ///< why "auto" fell back to MUMPS's own ordering (else empty)
@@ -85,8 +91,8 @@ struct Flexibility
 ///   inverse (dpotrf, dpotri) of each block. The
 ///   returned factor is the same factorization (PETSc runs MUMPS's condensation and
 ///   expansion phases around the Schur solve, so MatSolve gives K⁻¹b). PETSc cannot solve
-///   with a Schur factor in parallel, so with more than one rank "schur" is replaced by
-///   "inverse_entries" (Flexibility::method says which ran).
+///   with a Schur factor in parallel, so with more than one rank MUMPS is driven directly
+///   (distributed_schur.h): the factor is then Flexibility::distributed, and `factor` null.
 /// * "inverse_entries": one plain factorization, then MUMPS computes the n_c² requested
 ///   entries of K⁻¹ directly (ICNTL(30), PETSc's MatMumpsGetInverse), exploiting the sparsity
 ///   of the unit right-hand sides. Serial and parallel.
@@ -100,7 +106,8 @@ struct Flexibility
 /// @param ordering fill-reducing ordering (ordering.h): "auto" ("metis" for 3D elasticity,
 ///   "mumps" otherwise), "metis" (nested dissection of the nodal graph, the Schur variables
 ///   last), "mumps" (MUMPS's automatic choice), "amd", "amf", "pord" or "qamd"; on several
-///   ranks MUMPS's automatic choice is used
+///   ranks "schur" takes it too (METIS on the nodal graph gathered on rank 0), the other
+///   methods MUMPS's automatic choice
 /// @param per_body condense each block (body) on its own (default); false: one block
 /// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
 /// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)

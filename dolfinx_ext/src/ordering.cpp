@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstring>
+#include <mpi.h>
 #include <stdexcept>
 #include <utility>
 
@@ -64,6 +66,117 @@ void nodal_graph(Mat K, PetscInt bs, std::vector<idx_t>& xadj, std::vector<idx_t
   err.check(MatRestoreRowIJ(K, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done),
             "MatRestoreRowIJ");
 }
+/// @brief Pivot position (1-based, MUMPS's PERM_IN) of each of the N rows from METIS nested
+/// dissection of the nodal graph (xadj, adj; bs rows per node), the `last` rows moved to the
+/// end in their given order.
+std::vector<int> pivot_order(std::vector<idx_t>& xadj, std::vector<idx_t>& adj, PetscInt bs,
+                             PetscInt N, std::span<const PetscInt> last)
+{
+  idx_t n = static_cast<idx_t>(N / bs);
+  std::vector<idx_t> perm(n), iperm(n);
+  std::array<idx_t, METIS_NOPTIONS> options;
+  METIS_SetDefaultOptions(options.data());
+  int rc = METIS_OK;
+  if (n > 0)
+    rc = METIS_NodeND(&n, xadj.data(), adj.data(), nullptr, options.data(), perm.data(),
+                      iperm.data());
+  if (rc != METIS_OK)
+    throw std::runtime_error("METIS_NodeND failed (return code " + std::to_string(rc)
+                             + ") on the nodal graph of K (" + std::to_string(n) + " nodes)");
+
+  // Pivot position of each row: its node's place in METIS's order, the node's rows kept
+  // together; then the `last` rows moved to the end and the others closed up.
+  std::vector<PetscInt> order(N); // order[position] = row
+  for (idx_t v = 0; v < n; ++v)
+    for (PetscInt c = 0; c < bs; ++c)
+      order[static_cast<std::size_t>(iperm[v]) * bs + c] = static_cast<PetscInt>(v) * bs + c;
+  std::vector<char> is_last(N, 0);
+  for (PetscInt r : last)
+    is_last[r] = 1;
+  std::vector<int> perm_in(N);
+  int pos = 0;
+  for (PetscInt r : order)
+    if (!is_last[r])
+      perm_in[r] = ++pos;
+  for (PetscInt r : last)
+    perm_in[r] = ++pos;
+  return perm_in;
+}
+
+/// @brief The edges (v, w), v ≠ w, of the nodal graph from the locally owned rows of K
+/// (global node numbers, bs rows per node), flattened; either direction may be missing
+/// (an SBAIJ K stores the upper triangle only).
+std::vector<std::int64_t> local_node_edges(Mat K, PetscInt bs, PetscInt rstart, PetscInt rend)
+{
+  PetscErrorScope err;
+  std::vector<std::int64_t> edges;
+  std::vector<std::int64_t> nbrs;
+  err.check(MatGetRowUpperTriangular(K), "MatGetRowUpperTriangular");
+  for (PetscInt v = rstart / bs; v < rend / bs; ++v)
+  {
+    nbrs.clear();
+    for (PetscInt r = v * bs; r < (v + 1) * bs; ++r)
+    {
+      PetscInt ncols = 0;
+      const PetscInt* cols = nullptr;
+      err.check(MatGetRow(K, r, &ncols, &cols, nullptr), "MatGetRow");
+      for (PetscInt k = 0; k < ncols; ++k)
+        if (cols[k] / bs != v)
+          nbrs.push_back(cols[k] / bs);
+      err.check(MatRestoreRow(K, r, &ncols, &cols, nullptr), "MatRestoreRow");
+    }
+    std::sort(nbrs.begin(), nbrs.end());
+    nbrs.erase(std::unique(nbrs.begin(), nbrs.end()), nbrs.end());
+    for (std::int64_t w : nbrs)
+    {
+      edges.push_back(v);
+      edges.push_back(w);
+    }
+  }
+  err.check(MatRestoreRowUpperTriangular(K), "MatRestoreRowUpperTriangular");
+  return edges;
+}
+
+/// @brief All ranks' `local` concatenated in rank order on rank 0 (empty elsewhere).
+std::vector<std::int64_t> gather_on_root(MPI_Comm comm, const std::vector<std::int64_t>& local)
+{
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int count = static_cast<int>(local.size());
+  std::vector<int> counts(size), offsets(size + 1, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  for (int r = 0; r < size; ++r)
+    offsets[r + 1] = offsets[r] + counts[r];
+  std::vector<std::int64_t> all(rank == 0 ? offsets.back() : 0);
+  MPI_Gatherv(local.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
+              MPI_INT64_T, 0, comm);
+  return all;
+}
+
+/// @brief METIS's symmetric graph (both directions, no repeats) of n nodes from edges
+/// (v, w) given in either or both directions.
+void graph_from_edges(std::int64_t n, const std::vector<std::int64_t>& edges,
+                      std::vector<idx_t>& xadj, std::vector<idx_t>& adj)
+{
+  std::vector<std::vector<idx_t>> nbrs(n);
+  for (std::size_t k = 0; k < edges.size(); k += 2)
+  {
+    nbrs[edges[k]].push_back(static_cast<idx_t>(edges[k + 1]));
+    nbrs[edges[k + 1]].push_back(static_cast<idx_t>(edges[k]));
+  }
+  xadj.assign(n + 1, 0);
+  adj.clear();
+  for (std::int64_t v = 0; v < n; ++v)
+  {
+    std::vector<idx_t>& l = nbrs[v];
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+    adj.insert(adj.end(), l.begin(), l.end());
+    xadj[v + 1] = static_cast<idx_t>(adj.size());
+    std::vector<idx_t>().swap(l);
+  }
+}
 } // namespace
 
 bool flexcontact::is_ordering(const std::string& name)
@@ -116,35 +229,31 @@ std::vector<int> flexcontact::metis_pivot_order(Mat K, std::span<const PetscInt>
     bs = 1;
   std::vector<idx_t> xadj, adj;
   nodal_graph(K, bs, xadj, adj);
-  idx_t n = static_cast<idx_t>(N / bs);
-  std::vector<idx_t> perm(n), iperm(n);
-  std::array<idx_t, METIS_NOPTIONS> options;
-  METIS_SetDefaultOptions(options.data());
-  int rc = METIS_OK;
-  if (n > 0)
-    rc = METIS_NodeND(&n, xadj.data(), adj.data(), nullptr, options.data(), perm.data(),
-                      iperm.data());
-  if (rc != METIS_OK)
-    throw std::runtime_error("METIS_NodeND failed (return code " + std::to_string(rc)
-                             + ") on the nodal graph of K (" + std::to_string(n) + " nodes)");
+  return pivot_order(xadj, adj, bs, N, last);
+}
 
-  // Pivot position of each row: its node's place in METIS's order, the node's rows kept
-  // together; then the `last` rows moved to the end and the others closed up.
-  std::vector<PetscInt> order(N); // order[position] = row
-  for (idx_t v = 0; v < n; ++v)
-    for (PetscInt c = 0; c < bs; ++c)
-      order[static_cast<std::size_t>(iperm[v]) * bs + c] = static_cast<PetscInt>(v) * bs + c;
-  std::vector<char> is_last(N, 0);
-  for (PetscInt r : last)
-    is_last[r] = 1;
-  std::vector<int> perm_in(N);
-  int pos = 0;
-  for (PetscInt r : order)
-    if (!is_last[r])
-      perm_in[r] = ++pos;
-  for (PetscInt r : last)
-    perm_in[r] = ++pos;
-  return perm_in;
+std::vector<int> flexcontact::metis_pivot_order_gathered(Mat K, std::span<const PetscInt> last)
+{
+  PetscErrorScope err;
+  MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  PetscInt N = 0, bs = 1, rstart = 0, rend = 0;
+  err.check(MatGetSize(K, &N, nullptr), "MatGetSize");
+  err.check(MatGetBlockSize(K, &bs), "MatGetBlockSize");
+  err.check(MatGetOwnershipRange(K, &rstart, &rend), "MatGetOwnershipRange");
+  // Nodes must not straddle ranks: else the graph is taken DOF by DOF.
+  int aligned = (bs >= 1 and N % bs == 0 and rstart % bs == 0 and rend % bs == 0) ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &aligned, 1, MPI_INT, MPI_MIN, comm);
+  if (!aligned)
+    bs = 1;
+  const std::vector<std::int64_t> edges = local_node_edges(K, bs, rstart, rend);
+  const std::vector<std::int64_t> all = gather_on_root(comm, edges);
+  if (rank != 0)
+    return {};
+  std::vector<idx_t> xadj, adj;
+  graph_from_edges(static_cast<std::int64_t>(N / bs), all, xadj, adj);
+  return pivot_order(xadj, adj, bs, N, last);
 }
 
 void flexcontact::reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm_in)

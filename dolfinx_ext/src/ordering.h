@@ -46,6 +46,10 @@ std::string ordering_name(int infog7);
 /// The rows `last` (the Schur variables) are put last, in the given order, as MUMPS needs.
 std::vector<int> metis_pivot_order(Mat K, std::span<const PetscInt> last);
 
+/// @brief metis_pivot_order() for a K distributed by rows: the nodal graph of each rank's rows
+/// is gathered on rank 0, which orders it. Collective; PERM_IN on rank 0, empty elsewhere.
+std::vector<int> metis_pivot_order_gathered(Mat K, std::span<const PetscInt> last);
+
 /// @brief The MUMPS instance inside PETSc's factor is not laid out as this build expects
 /// (another PETSc): no ordering can be handed to it; nothing was changed.
 struct MumpsLayoutError : std::runtime_error

@@ -8,8 +8,9 @@ from __future__ import annotations
 from typing import Iterable, Literal, get_args
 
 FlexibilityMethod = Literal["schur", "inverse_entries", "matmatsolve"]
-"""How F* = (K⁻¹)_cc is computed: MUMPS Schur complement (on several ranks it runs as
-"inverse_entries"), MUMPS selected inverse entries, or a multi-right-hand-side solve."""
+"""How F* = (K⁻¹)_cc is computed: MUMPS Schur complement (on several ranks from MUMPS driven
+directly, distributed_schur.h), MUMPS selected inverse entries, or a multi-right-hand-side
+solve."""
 
 Ordering = Literal["auto", "metis", "mumps", "amd", "amf", "pord", "qamd"]
 """The fill-reducing ordering of the MUMPS factorization of K: "auto" (the default: "metis"

@@ -160,9 +160,9 @@ class ContactProblem:
         TippingWarning. Default False: such a body is an error, as without contact.
     stress : optional callable u -> UFL scalar (e.g. von Mises) written as a DG0 field.
     solver : kernel SolverOptions (tolerance, max_iterations, chain).
-    flexibility : "schur" (MUMPS Schur complement; on several ranks PETSc cannot solve with
-        that factor, so MUMPS selected inverse entries are used: "inverse_entries"),
-        "inverse_entries", or "matmatsolve" (a multi-right-hand-side solve, the reference).
+    flexibility : "schur" (MUMPS Schur complement; on several ranks MUMPS is driven
+        directly, the complement centralised on rank 0), "inverse_entries" (MUMPS selected
+        inverse entries), or "matmatsolve" (a multi-right-hand-side solve, the reference).
         Each makes one sparse factorization, which then serves every solve.
     ordering : fill-reducing ordering of that factorization: "auto" (default: "metis" in
         3D, "mumps" in 2D), "metis" (METIS nested dissection handed to MUMPS), "mumps"

@@ -1,0 +1,348 @@
+// Copyright flexcontact developers. MIT licence.
+
+#include "distributed_schur.h"
+#include "collective.h"
+#include "contact_blocks.h"
+#include "ordering.h"
+#include "flexibility.h"
+#include "petsc_error.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <memory>
+
+using namespace flexcontact;
+
+namespace
+{
+/// @brief MUMPS's ICNTL(i), 1-based as in its guide.
+int& icntl(DMUMPS_STRUC_C& id, int i) { return id.icntl[i - 1]; }
+int infog(const DMUMPS_STRUC_C& id, int i) { return id.infog[i - 1]; }
+
+/// @brief The upper triangle (col ≥ row) of K's local rows as 1-based triplets.
+void local_upper_triplets(Mat K, std::vector<int>& irn, std::vector<int>& jcn,
+                          std::vector<double>& a)
+{
+  PetscErrorScope err;
+  PetscInt rstart = 0, rend = 0;
+  err.check(MatGetOwnershipRange(K, &rstart, &rend), "MatGetOwnershipRange");
+  MatInfo info;
+  err.check(MatGetInfo(K, MAT_LOCAL, &info), "MatGetInfo");
+  const auto guess = static_cast<std::size_t>(info.nz_used / 2 + (rend - rstart));
+  irn.clear(), jcn.clear(), a.clear();
+  irn.reserve(guess), jcn.reserve(guess), a.reserve(guess);
+  // An SBAIJ K gives its stored upper triangle; an AIJ K its full rows, halved here.
+  err.check(MatGetRowUpperTriangular(K), "MatGetRowUpperTriangular");
+  for (PetscInt r = rstart; r < rend; ++r)
+  {
+    PetscInt ncols = 0;
+    const PetscInt* cols = nullptr;
+    const PetscScalar* vals = nullptr;
+    err.check(MatGetRow(K, r, &ncols, &cols, &vals), "MatGetRow");
+    for (PetscInt k = 0; k < ncols; ++k)
+      if (cols[k] >= r)
+      {
+        irn.push_back(static_cast<int>(r + 1));
+        jcn.push_back(static_cast<int>(cols[k] + 1));
+        a.push_back(vals[k]);
+      }
+    err.check(MatRestoreRow(K, r, &ncols, &cols, &vals), "MatRestoreRow");
+  }
+  err.check(MatRestoreRowUpperTriangular(K), "MatRestoreRowUpperTriangular");
+}
+} // namespace
+
+DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, int icntl7,
+                                   std::vector<int> perm_in)
+{
+  PetscErrorScope err;
+  comm_ = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+  MPI_Comm_rank(comm_, &rank_);
+  err.check(MatGetSize(K, &n_, nullptr), "MatGetSize");
+  if (n_ > std::numeric_limits<int>::max() - 1)
+    throw std::invalid_argument("K has " + std::to_string(n_) + " rows: more than MUMPS's "
+                                "32-bit indices hold");
+  n_c_ = static_cast<int>(schur.size());
+  local_upper_triplets(K, irn_, jcn_, a_);
+
+  Vec layout = nullptr;
+  err.check(MatCreateVecs(K, nullptr, &layout), "MatCreateVecs");
+  PetscErrorCode ierr = VecScatterCreateToZero(layout, &to_zero_, &host_);
+  VecDestroy(&layout);
+  err.check(ierr, "VecScatterCreateToZero");
+
+  id_.job = -1;
+  id_.par = 1; // the host works too
+  id_.sym = 2; // symmetric, LDLᵀ with pivoting, as PETSc's Cholesky of K in serial
+  id_.comm_fortran = static_cast<int>(MPI_Comm_c2f(comm_));
+  dmumps_c(&id_);
+  if (infog(id_, 1) < 0)
+    throw_mumps_error("initialization", infog(id_, 1), infog(id_, 2));
+  alive_ = true;
+  try
+  {
+    icntl(id_, 1) = icntl(id_, 2) = icntl(id_, 3) = -1; // no printing
+    icntl(id_, 4) = 0;
+    icntl(id_, 5) = 0;  // assembled
+    icntl(id_, 18) = 3; // distributed triplets
+    icntl(id_, 20) = 0; // dense right-hand side on the host
+    icntl(id_, 21) = 0; // solution on the host
+    icntl(id_, 24) = 1; // detect null pivots (INFOG(28)) instead of dividing by ~0
+    icntl(id_, 28) = 1; // sequential analysis: takes PERM_IN (no ParMETIS/PT-SCOTCH here)
+    icntl(id_, 7) = icntl7;
+    id_.n = static_cast<int>(n_);
+    id_.nnz_loc = static_cast<MUMPS_INT8>(a_.size());
+    id_.nz_loc = a_.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max())
+                     ? static_cast<int>(a_.size()) : 0;
+    id_.irn_loc = irn_.data();
+    id_.jcn_loc = jcn_.data();
+    id_.a_loc = a_.data();
+    if (rank_ == 0 and icntl7 == 1)
+    {
+      perm_in_ = std::move(perm_in);
+      id_.perm_in = perm_in_.data();
+    }
+    if (n_c_ > 0)
+    {
+      icntl(id_, 19) = 1; // Schur complement centralised on the host (by rows)
+      id_.size_schur = n_c_;
+      if (rank_ == 0)
+      {
+        listvar_.resize(n_c_);
+        for (int k = 0; k < n_c_; ++k)
+          listvar_[k] = static_cast<int>(schur[k] + 1);
+        schur_.assign(static_cast<std::size_t>(n_c_) * n_c_, 0.0);
+        id_.listvar_schur = listvar_.data();
+        id_.schur = schur_.data();
+        id_.schur_lld = n_c_;
+      }
+    }
+    double t0 = MPI_Wtime();
+    call(1, "analysis");
+    stats_.analysis_s = MPI_Wtime() - t0;
+    stats_.infog7 = infog(id_, 7);
+    factorize();
+  }
+  catch (...)
+  {
+    release();
+    throw;
+  }
+}
+
+void DistributedSchur::factorize()
+{
+  double t0 = MPI_Wtime();
+  // As in serial (flexibility.cpp): LDLᵀ with pivoting can outgrow the workspace the
+  // analysis estimated; MUMPS's remedy is a larger ICNTL(14), the analysis stays valid.
+  for (;;)
+  {
+    id_.job = 2;
+    dmumps_c(&id_);
+    const int e = infog(id_, 1);
+    if ((e == -8 or e == -9) and stats_.retries < 5)
+    {
+      icntl(id_, 14) = std::max(2 * icntl(id_, 14), 50);
+      ++stats_.retries;
+      continue;
+    }
+    if (e < 0)
+      throw_mumps_error("factorization", e, infog(id_, 2));
+    break;
+  }
+  stats_.factorization_s = MPI_Wtime() - t0;
+  stats_.null_pivots = infog(id_, 28);
+  throw_if_null_pivots(stats_.null_pivots);
+  const int e29 = infog(id_, 29);
+  stats_.factor_entries = e29 >= 0 ? e29 : -static_cast<std::int64_t>(e29) * 1000000;
+  stats_.factor_flops = id_.rinfog[2];
+  stats_.factor_memory_mb = infog(id_, 22);
+  // The Dirichlet rows and the values are not needed any more: MUMPS holds the factor.
+  std::vector<int>().swap(irn_);
+  std::vector<int>().swap(jcn_);
+  std::vector<double>().swap(a_);
+  id_.irn_loc = id_.jcn_loc = nullptr;
+  id_.a_loc = nullptr;
+  id_.nnz_loc = 0;
+  id_.nz_loc = 0;
+}
+
+void DistributedSchur::call(int job, const char* phase)
+{
+  id_.job = job;
+  dmumps_c(&id_);
+  if (infog(id_, 1) < 0) // INFOG is global: every rank throws
+    throw_mumps_error(phase, infog(id_, 1), infog(id_, 2));
+}
+
+DistributedSchur::~DistributedSchur() { release(); }
+
+void DistributedSchur::release()
+{
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (alive_ and !finalized)
+  {
+    id_.job = -2;
+    dmumps_c(&id_);
+  }
+  alive_ = false;
+  if (!finalized and !PetscFinalizeCalled)
+  {
+    VecScatterDestroy(&to_zero_);
+    VecDestroy(&host_);
+  }
+  std::vector<double>().swap(schur_);
+  std::vector<double>().swap(rhs_);
+  std::vector<double>().swap(condensed_rhs_);
+}
+
+const double* DistributedSchur::schur_complement()
+{
+  if (rank_ != 0 or schur_is_inverse_ or n_c_ == 0)
+    return nullptr;
+  // MUMPS gives the lower triangle by rows, i.e. the upper one read by columns: mirror it.
+  const std::size_t n = static_cast<std::size_t>(n_c_);
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = j + 1; i < n; ++i)
+      schur_[i + j * n] = schur_[j + i * n];
+  return schur_.data();
+}
+
+void DistributedSchur::set_flexibility(const Eigen::MatrixXd& F)
+{
+  if (rank_ == 0)
+  {
+    if (F.rows() != n_c_ or F.cols() != n_c_)
+      throw std::invalid_argument("F* has the wrong size");
+    std::memcpy(schur_.data(), F.data(), schur_.size() * sizeof(double));
+  }
+  schur_is_inverse_ = true;
+}
+
+void DistributedSchur::scatter_back(const double* host, Vec x)
+{
+  PetscErrorScope err;
+  if (rank_ == 0)
+  {
+    PetscScalar* h = nullptr;
+    err.check(VecGetArray(host_, &h), "VecGetArray");
+    std::copy(host, host + n_, h);
+    err.check(VecRestoreArray(host_, &h), "VecRestoreArray");
+  }
+  err.check(VecScatterBegin(to_zero_, host_, x, INSERT_VALUES, SCATTER_REVERSE), "VecScatterBegin");
+  err.check(VecScatterEnd(to_zero_, host_, x, INSERT_VALUES, SCATTER_REVERSE), "VecScatterEnd");
+}
+
+std::vector<double> DistributedSchur::condense(Vec b)
+{
+  if (!alive_)
+    throw std::runtime_error("the distributed MUMPS factor was released");
+  PetscErrorScope err;
+  err.check(VecScatterBegin(to_zero_, b, host_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  err.check(VecScatterEnd(to_zero_, b, host_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
+  if (rank_ == 0)
+  {
+    const PetscScalar* h = nullptr;
+    err.check(VecGetArrayRead(host_, &h), "VecGetArrayRead");
+    condensed_rhs_.assign(h, h + n_);
+    err.check(VecRestoreArrayRead(host_, &h), "VecRestoreArrayRead");
+    redrhs_.assign(n_c_, 0.0);
+    id_.rhs = condensed_rhs_.data();
+    id_.redrhs = redrhs_.data();
+    id_.lrhs = static_cast<int>(n_);
+    id_.lredrhs = std::max(n_c_, 1);
+  }
+  id_.nrhs = 1;
+  icntl(id_, 26) = n_c_ > 0 ? 1 : 0;
+  call(3, "condensation");
+  condensed_ = true;
+  return rank_ == 0 ? redrhs_ : std::vector<double>();
+}
+
+void DistributedSchur::expand(std::span<const double> u_c, Vec x)
+{
+  if (!condensed_)
+    throw std::runtime_error("expand() needs a condense() first");
+  if (rank_ == 0)
+  {
+    std::copy(u_c.begin(), u_c.end(), redrhs_.begin());
+    id_.rhs = condensed_rhs_.data();
+    id_.redrhs = redrhs_.data();
+  }
+  id_.nrhs = 1;
+  icntl(id_, 26) = n_c_ > 0 ? 2 : 0;
+  if (n_c_ > 0)
+    call(3, "expansion");
+  scatter_back(condensed_rhs_.data(), x);
+}
+
+void DistributedSchur::solve(Vec b, Vec x)
+{
+  if (n_c_ > 0 and !schur_is_inverse_) // the same on every rank
+    throw std::logic_error("DistributedSchur::solve before set_flexibility");
+  std::vector<double> rb = condense(b);
+  std::vector<double> uc(rb.size());
+  if (rank_ == 0 and n_c_ > 0)
+  {
+    Eigen::Map<const Eigen::MatrixXd> F(schur_.data(), n_c_, n_c_);
+    Eigen::Map<Eigen::VectorXd>(uc.data(), n_c_)
+        = F * Eigen::Map<const Eigen::VectorXd>(rb.data(), n_c_);
+  }
+  expand(uc, x);
+}
+
+Flexibility flexcontact::distributed_flexibility(Mat K, const std::vector<PetscInt>& dofs,
+                                                const std::string& ordering,
+                                                const std::vector<std::vector<int>>& blocks)
+{
+  MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  Flexibility out;
+  out.method = "schur";
+  out.ordering = ordering;
+  out.n_contact_dofs = static_cast<int>(dofs.size());
+  const int icntl7 = mumps_icntl7(ordering);
+  double t0 = MPI_Wtime();
+  std::vector<int> perm_in;
+  if (icntl7 == 1)
+    perm_in = metis_pivot_order_gathered(K, dofs);
+  out.ordering_s = MPI_Wtime() - t0;
+  auto f = std::make_shared<DistributedSchur>(K, dofs, icntl7, std::move(perm_in));
+  out.factorization_s = MPI_Wtime() - t0;
+  const DistributedFactorStats& st = f->stats();
+  out.analysis_s = st.analysis_s;
+  out.factorizations = 1;
+  out.factorization_retries = st.retries;
+  out.null_pivots = st.null_pivots;
+  out.mumps_ordering = ordering_name(st.infog7);
+  out.factor_entries = st.factor_entries;
+  out.factor_flops = st.factor_flops;
+  out.factor_memory_mb = st.factor_memory_mb;
+
+  double t1 = MPI_Wtime();
+  const double* S = f->schur_complement();
+  out.schur_s = MPI_Wtime() - t1;
+  bool singular = false;
+  std::string what;
+  if (rank == 0 and !dofs.empty())
+  {
+    try
+    {
+      out.F = blockwise_inverse(S, dofs.size(), blocks);
+    }
+    catch (const SingularStiffnessError& e)
+    {
+      singular = true;
+      what = e.what();
+    }
+  }
+  throw_collective_if(comm, singular, what,
+                      [](const std::string& w) { throw SingularStiffnessError(w); });
+  f->set_flexibility(out.F);
+  out.inverse_s = MPI_Wtime() - t1 - out.schur_s;
+  out.distributed = std::move(f);
+  return out;
+}
