@@ -22,7 +22,7 @@ std::vector<std::string> solver_names() { return {"active_set", "projection", "n
 double chain_time_budget_s(long n)
 {
   const double k = static_cast<double>(std::max(n, 0L)) / 1000.0;
-  return 3.0 + 10.0 * k * k * k;
+  return 10.0 + 10.0 * k * k * k;
 }
 
 std::vector<std::string> default_chain()

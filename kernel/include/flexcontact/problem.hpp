@@ -67,10 +67,11 @@ struct SolverOptions
 };
 
 /// @brief The chain's wall-clock budget when SolverOptions::time_budget_s is 0, for n
-/// unknowns: 3 s + 10 s · (n / 1000)³ (3.06 s at 180 unknowns, 13 s at 1,000, 273 s at
+/// unknowns: 10 s + 10 s · (n / 1000)³ (10.06 s at 180 unknowns, 20 s at 1,000, 280 s at
 /// 3,000). The cubic term is about 30 dense factorisations of the Newton matrix on one
 /// core; the constant lets the hardest small problems use the ~1,000 damped Newton steps
-/// they need (condition numbers near 1e10).
+/// they need (condition numbers near 1e10) and still leaves the projection its turn: with
+/// 3 s, 8 of 6,000 random problems that the projection alone solves in 4–6 s were lost.
 double chain_time_budget_s(long n);
 
 /// @brief What a local solver did and found.

@@ -74,7 +74,7 @@ std::vector<std::string> default_chain();
 /// ρ = 1/‖W_kk‖₂ and a Goldstein–Price search, the same with Armijo's search, Armijo's
 /// with the normal/tangential ρ, and the restarted Newton with the block ρ; they solve
 /// different subsets of the hard problems. The whole chain stops trying once opt.time_budget_s (0:
-/// chain_time_budget_s(n), 3 s + 10 s·(n/1000)³) has passed, with a line in `attempts`;
+/// chain_time_budget_s(n), 10 s + 10 s·(n/1000)³) has passed, with a line in `attempts`;
 /// each attempt also stops at it. The report is the converging solver's, with `attempts`
 /// listing every try; if none converges it is the best one's (smallest residual) with
 /// converged=false.
