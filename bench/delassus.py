@@ -67,7 +67,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
-    print(f"{'case':28} {'n_c':>6} {'m·d':>6} {'delassus CPU s':>14} {'CondensedContact CPU s':>22} "
+    print(f"{'case':28} {'n_c':>6} {'m·d':>6} {'delassus CPU s':>14} "
+          f"{'CondensedContact CPU s':>22} "
           f"{'first call CPU s':>17} {'rel. diff':>10}")
     for name, dim, m, k in (("2D node-node (2d_800k)", 2, 1001, 1),
                             ("3D node-node (3d_120k)", 3, 674, 1),
@@ -82,7 +83,8 @@ def main():
         W = _cpp.delassus(pairs, n_nodes, dim, F)
         ref = dense_product(F, pairs, n_nodes, dim)
         diff = np.abs(W - ref).max() / np.abs(ref).max()
-        print(f"{name:28} {F.shape[0]:6d} {m * dim:6d} {t_w:14.4f} {t_c:22.4f} {t_first:17.4f} {diff:10.1e}",
+        print(f"{name:28} {F.shape[0]:6d} {m * dim:6d} {t_w:14.4f} {t_c:22.4f} "
+              f"{t_first:17.4f} {diff:10.1e}",
               flush=True)
 
 

@@ -9,7 +9,8 @@ K and contact DOFs as ContactProblem), this calls ``_cpp.flexibility(K, dofs, "s
 ordering)`` for "mumps" and "metis" alternately, ``--repeat`` times each, and reports the
 run of least CPU time (ordering, analysis, factorization, Schur complement, per-body inverse),
 its process CPU time (one thread: on a shared machine the wall time mostly measures the
-other processes), its parts and MUMPS's entries and flops (deterministic), plus the plain factorization
+other processes), its parts and MUMPS's entries and flops (deterministic), plus the plain
+factorization
 (no Schur complement, MUMPS's choice: PORD) for scale. Writes schur_ordering_2d.json.
 """
 from __future__ import annotations
@@ -90,7 +91,8 @@ def main():
           f"{'Schur s':>8} {'inverse s':>9} {'entries':>9} {'flops':>9}")
     for c in cases:
         for k, r in c["best"].items():
-            print(f"{c['case']:15} {k:8} {r['cpu_s']:8.2f} {r['total_s']:8.2f} {r['ordering_s']:8.2f} "
+            print(f"{c['case']:15} {k:8} {r['cpu_s']:8.2f} {r['total_s']:8.2f} "
+                  f"{r['ordering_s']:8.2f} "
                   f"{r['factorization_s']:9.2f} {r['schur_s']:8.2f} {r['inverse_s']:9.2f} "
                   f"{r['factor_entries'] / 1e6:8.1f}M {r['factor_flops']:9.2e}")
     print(f"written {args.out} ({result['total_s']:.0f} s)")
