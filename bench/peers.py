@@ -1,6 +1,7 @@
 """flexcontact against real peers: same mesh, same load, same accuracy; total times.
 
     /usr/bin/python3 bench/peers.py [--full]     # writes bench/peers.json, prints a table
+    /usr/bin/python3 bench/peers.py --cases hertz3d    # these cases again, merged into it
 
 Peers (see bench/README.md):
 
@@ -24,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import sys
 import time
@@ -39,10 +41,9 @@ from peers_cases import MU_FRICTION, agreement, build_case, measure  # noqa: E40
 from flexcontact.info import describe  # noqa: E402
 
 INCREMENTS = 20
-# (dim, kind, refine, loadings): the 3D Hertz mesh at about 60k DOFs (hertz3d --refine 1);
-# its 20-increment loading only with --full (GetFEM refactorizes at every Newton iteration).
+# (dim, kind, refine, loadings): the 3D Hertz mesh at about 60k DOFs (hertz3d --refine 1).
 DEFAULT = [(2, "hertz", 1, ("single", "incremental")), (2, "rigid", 1, ("single", "incremental")),
-           (3, "hertz", 1, ("single",)), (3, "rigid", 1, ("single",))]
+           (3, "hertz", 1, ("single", "incremental")), (3, "rigid", 1, ("single",))]
 FULL = [(2, "hertz", 3, ("single", "incremental")), (2, "rigid", 3, ("single", "incremental")),
         (3, "hertz", 1, ("single", "incremental")), (3, "rigid", 1, ("single", "incremental"))]
 
@@ -66,11 +67,14 @@ def _peer(case, ref, solve, *args) -> dict:
 
 def run_case(dim: int, kind: str, refine: int, loadings) -> dict:
     """Every code on one mesh; returns the JSON record of the case."""
+    t0 = time.perf_counter()
+    started = time.strftime("%Y-%m-%d %H:%M:%S UTC", time.gmtime())
+    load = os.getloadavg()[0]
     case = build_case(dim, kind, refine)
     delta = pf.calibrate(case)
     rec = {"case": case.name, "dim": dim, "kind": kind, "refine": refine, "dofs": case.dofs(),
            "slave_nodes": len(case.areas), "h_contact_m": case.geo["h_contact"],
-           "approach_m": delta, "loadings": {}}
+           "approach_m": delta, "started": started, "loadings": {}}
     rec["linear_solve"] = {f: pf.linear_solve(case, delta, f) for f in ("lu", "cholesky")}
     rec["linear_solve_s"] = min(v["time_s"] for v in rec["linear_solve"].values())
     for loading in loadings:
@@ -94,6 +98,8 @@ def run_case(dim: int, kind: str, refine: int, loadings) -> dict:
     if single:
         rec["flexcontact_over_linear_solve"] = (single["flexcontact"]["time_s"]
                                                 / rec["linear_solve_s"])
+    rec["case_s"] = time.perf_counter() - t0
+    rec["load_average"] = [load, os.getloadavg()[0]]
     return rec
 
 
@@ -105,11 +111,18 @@ def machine() -> dict:
     return info
 
 
-def run(full: bool = False) -> dict:
-    """Run every case (the default set, or the larger ``full`` one) and return the record
-    that ``bench/peers.json`` holds."""
+def run(full: bool = False, names=None) -> dict:
+    """Run every case (the default set, or the larger ``full`` one; only those named in
+    ``names``, e.g. ["hertz3d"], if given) and return the record that ``bench/peers.json``
+    holds."""
     t0 = time.perf_counter()
-    cases = [run_case(*c) for c in (FULL if full else DEFAULT)]
+    chosen = [c for c in (FULL if full else DEFAULT)
+              if names is None or f"{c[1]}{c[0]}d" in names]
+    if names is not None and not chosen:
+        raise ValueError(f"--cases {' '.join(names)}: no such case in the "
+                         f"{'full' if full else 'default'} set (hertz2d, rigid2d, hertz3d, "
+                         "rigid3d)")
+    cases = [run_case(*c) for c in chosen]
     return {"machine": machine(), "full": full, "increments": INCREMENTS,
             "mu_friction": MU_FRICTION, "snes_kappa_factor_E_over_h": ps.KAPPA_FACTOR,
             "getfem_available": pg.available(), "cases": cases,
@@ -145,16 +158,34 @@ def table(result: dict) -> str:
     return "\n".join(lines)
 
 
+def merge(old: dict, new: dict) -> dict:
+    """``old`` (a peers.json) with the cases of ``new`` replaced or added; ``runs`` lists
+    which cases each run wrote and how long it took."""
+    fresh = {c["case"]: c for c in new["cases"]}
+    runs = old.get("runs") or [{"cases": [c["case"] for c in old["cases"]],
+                                "full": old.get("full", False), "total_s": old["total_s"]}]
+    cases = [fresh.pop(c["case"], c) for c in old["cases"]] + list(fresh.values())
+    runs = runs + [{"cases": [c["case"] for c in new["cases"]], "full": new["full"],
+                    "total_s": new["total_s"]}]
+    return {**new, "cases": cases, "runs": runs}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--full", action="store_true",
                         help="2D at --refine 3 and the 20-increment loading in 3D")
     parser.add_argument("--out", default=str(HERE / "peers.json"), help="JSON file to write")
+    parser.add_argument("--cases", nargs="+", metavar="NAME",
+                        help="only these cases (hertz2d rigid2d hertz3d rigid3d), merged into "
+                             "the existing --out file")
     args = parser.parse_args()
     if not pg.available():
         print("GetFEM (python3-getfem) is missing: its comparisons are skipped", flush=True)
-    result = run(args.full)
-    Path(args.out).write_text(json.dumps(result, indent=1, default=float))
+    result = run(args.full, args.cases)
+    out = Path(args.out)
+    if args.cases and out.exists():
+        result = merge(json.loads(out.read_text()), result)
+    out.write_text(json.dumps(result, indent=1, default=float))
     print(table(result))
     print(f"written {args.out} ({result['total_s']:.0f} s)")
 

@@ -94,12 +94,16 @@ def test_unknown_ordering_raises():
     assert set(ORDERINGS) == {"auto", "mumps", *ORDERED}
 
 
-@pytest.mark.parametrize("dim,n,expected", [(3, 3, "metis"), (2, 6, "mumps")])
-def test_auto_is_metis_in_3d_only(dim, n, expected):
-    """The default "auto" orders 3D elasticity (block size 3) with METIS, 2D with MUMPS."""
+@pytest.mark.parametrize("dim,n,schur,expected", [(3, 3, True, "metis"), (3, 3, False, "metis"),
+                                                   (2, 6, True, "mumps"), (2, 6, False, "mumps"),
+                                                   (2, 230, True, "metis")])
+def test_auto_is_metis_in_3d_and_for_large_schur_factors(dim, n, schur, expected):
+    """The default "auto" orders 3D elasticity (block size 3) with METIS, and a 2D factor
+    with a Schur complement from 100,000 DOFs on (230² squares: 106,722 DOFs); smaller or
+    plain 2D factors with MUMPS's choice."""
     msh, V, K, tags = elasticity(n, dim)
     _, dofs = contact_dofs(V, tags)
-    _, _, info = fc.flexibility(K, dofs)
+    _, _, info = fc.flexibility(K, dofs if schur else dofs[:0])
     assert info["ordering"] == expected
     assert (info["mumps_ordering"] == "metis") == (expected == "metis")
     # Both supported PETSc generations take our ordering: no fallback to MUMPS's own.

@@ -489,7 +489,8 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   out.method = used;
   // A given ordering is set by redoing MUMPS's analysis on rank 0's instance (ordering.h);
   // on several ranks through PETSc MUMPS's automatic choice stays.
-  out.ordering = (size > 1 and !direct) ? "mumps" : resolve_ordering(ordering, K);
+  out.ordering = (size > 1 and !direct) ? "mumps"
+                                        : resolve_ordering(ordering, K, used == "schur" and n_c > 0);
   out.ordering_auto = ordering == "auto";
   out.n_contact_dofs = n_c;
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
@@ -577,7 +578,7 @@ Flexibility flexcontact::factor_analysis(Mat K, std::span<const std::int64_t> co
                                   + "): " + std::to_string(d));
   err.check(MatSetOption(K, MAT_SYMMETRIC, PETSC_TRUE), "MatSetOption(MAT_SYMMETRIC)");
   Flexibility out;
-  out.ordering = resolve_ordering(ordering, K);
+  out.ordering = resolve_ordering(ordering, K, not dofs.empty());
   out.n_contact_dofs = static_cast<int>(dofs.size());
   double t0 = MPI_Wtime();
   OwnedMat F;

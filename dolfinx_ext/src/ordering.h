@@ -29,10 +29,13 @@ namespace flexcontact
 bool is_ordering(const std::string& name);
 
 /// @brief The ordering "auto" stands for: "metis" for K of block size 3 (3D elasticity,
-/// where METIS needs 2.7 times fewer flops than MUMPS's choice at 30k DOFs), "mumps"
-/// otherwise (in 2D METIS saves flops too, but at 200k DOFs ordering costs more time than it
-/// saves; bench/ordering.py). Other names are returned as they are.
-std::string resolve_ordering(const std::string& name, Mat K);
+/// where METIS needs 2.7 times fewer flops than MUMPS's choice at 30k DOFs) and for a K of
+/// at least 100,000 rows factored with a Schur complement (`schur`: MUMPS then keeps only
+/// AMD of its own; on the 2D Hertz meshes METIS with the contact DOFs last takes less time
+/// and fewer entries from 200k DOFs on, more time at 50k; bench/schur_ordering_2d.py),
+/// "mumps" otherwise (a plain 2D factor: MUMPS's PORD is as good as METIS there and needs
+/// no second analysis; bench/ordering.py). Other names are returned as they are.
+std::string resolve_ordering(const std::string& name, Mat K, bool schur = false);
 
 /// @brief MUMPS's ICNTL(7) for a resolved ordering name ("mumps" → 7, "amd" → 0, ...); 1 for
 /// "metis" (a user permutation).

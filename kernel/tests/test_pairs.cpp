@@ -164,3 +164,72 @@ TEST(Delassus, SymmetricAndEqualToBFBt)
   EXPECT_EQ((Wu - Wu.transpose()).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_THROW(delassus(B, Matrix::Identity(6, 6)), std::invalid_argument);
 }
+
+namespace
+{
+/// @brief F* of two bodies in 3D: SPD blocks on the nodes of each body (body[a] per contact
+/// node), exact zeros between bodies and on the rows and columns of the held DOFs.
+Matrix two_body_flexibility(const std::vector<int>& body, const std::vector<int>& held)
+{
+  const auto n = static_cast<Eigen::Index>(body.size()) * 3;
+  Matrix L(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j)
+      L(i, j) = std::sin(0.7 + 1.3 * i + 0.11 * j * j);
+  Matrix F = L * L.transpose() + Matrix::Identity(n, n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < n; ++j)
+      if (body[i / 3] != body[j / 3])
+        F(i, j) = 0.0;
+  for (const int h : held)
+  {
+    F.row(h).setZero();
+    F.col(h).setZero();
+  }
+  return F;
+}
+} // namespace
+
+TEST(Delassus, BlockDiagonalFlexibilityEqualsDenseProduct)
+{
+  // Slaves 0..3 on one body, masters 4..9 on the other: contiguous bodies (as the contact
+  // numbering gives), then the same with the bodies' nodes interleaved; some pairs with
+  // three master nodes, a held DOF inside each body.
+  for (const bool interleaved : {false, true})
+  {
+    std::vector<int> body(10), slave(4), master(6);
+    for (int a = 0; a < 10; ++a)
+      body[a] = interleaved ? a % 2 : (a < 4 ? 0 : 1);
+    for (int a = 0, s = 0, mm = 0; a < 10; ++a)
+      (body[a] == 0 && s < 4 ? slave[s++] : master[mm++]) = a;
+    const std::vector<ContactPair> pairs{
+        make_pair(slave[0], {master[0]}, {1.0}, vec({0.1, 0.2, 1.0})),
+        make_pair(slave[1], {master[1], master[2], master[3]}, {0.2, 0.3, 0.5},
+                  vec({0.0, -0.4, 1.0})),
+        make_pair(slave[2], {master[3], master[4], master[5]}, {0.6, 0.1, 0.3},
+                  vec({1.0, 0.3, 0.2})),
+        make_pair(slave[3], {master[5]}, {1.0}, vec({-0.5, 0.5, 0.7}))};
+    const Matrix F = two_body_flexibility(body, {slave[1] * 3 + 2, master[4] * 3});
+    const auto B = gap_operator(3, 10, pairs);
+    const Matrix W = delassus(B, F);
+    const Matrix Bd = Matrix(B);
+    const Matrix dense = Bd * F * Bd.transpose();
+    EXPECT_EQ((W - W.transpose()).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_LT((W - dense).cwiseAbs().maxCoeff(), 1e-14 * dense.cwiseAbs().maxCoeff())
+        << "interleaved " << interleaved;
+  }
+}
+
+TEST(Delassus, ZeroFlexibilityColumnsGiveZeroRows)
+{
+  // A pair whose slave and master DOFs are all held has no flexibility: its rows of W are 0.
+  const std::vector<ContactPair> pairs{make_pair(0, {1}, {1.0}, vec({0.0, 1.0})),
+                                       make_pair(2, {3}, {1.0}, vec({1.0, 1.0}))};
+  Matrix F = Matrix::Identity(8, 8);
+  F.topLeftCorner(4, 4).setZero();
+  const Matrix W = delassus(gap_operator(2, 4, pairs), F);
+  EXPECT_EQ(W.topRows(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(W.leftCols(2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(W(2, 2), 2.0, 1e-15);   // |n|² (1 + 1) for the free pair, T rows unit
+  EXPECT_NEAR(W(3, 3), 2.0, 1e-15);
+}

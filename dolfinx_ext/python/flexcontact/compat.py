@@ -178,6 +178,14 @@ def set_bc(b, bcs, scale: float = 1.0):
         dolfinx.fem.petsc.set_bc(b, bcs, scale=scale)
 
 
+def bc_is_homogeneous(bc) -> bool:
+    """True if the DirichletBC prescribes zero through a Constant as set now (``bc.g`` is
+    the C++ Constant or Function on 0.5 and 0.9); a Function value counts as non-zero
+    without being read."""
+    g = bc.g
+    return not hasattr(g, "x") and hasattr(g, "value") and not np.any(np.asarray(g.value))
+
+
 def create_petsc_vector(V):
     """A ghosted PETSc vector laid out like the Function space's DOFs."""
     import dolfinx.la

@@ -14,11 +14,13 @@ solve."""
 
 Ordering = Literal["auto", "metis", "mumps", "amd", "amf", "pord", "qamd"]
 """The fill-reducing ordering of the MUMPS factorization of K: "auto" (the default: "metis"
-in 3D, "mumps" in 2D), "metis" (METIS nested dissection of the mesh nodes handed to MUMPS),
-"mumps" (MUMPS's automatic choice among what Debian's MUMPS has: AMD, AMF, PORD, QAMD), or
-one of those four. On several ranks MUMPS's automatic choice is used. bench/ordering.py
-measures them: in 3D METIS needs 2.7 times fewer flops at 30k DOFs; in 2D it saves flops too
-but its own cost outweighs them at 200k DOFs."""
+in 3D and for a 2D factor with a Schur complement of at least 100,000 rows, "mumps"
+otherwise), "metis" (METIS nested dissection of the mesh nodes handed to MUMPS), "mumps"
+(MUMPS's automatic choice among what Debian's MUMPS has: AMD, AMF, PORD, QAMD; only AMD with
+a Schur complement), or one of those four. On several ranks MUMPS's automatic choice is
+used. bench/ordering.py and bench/schur_ordering_2d.py measure them: in 3D METIS needs 2.7
+times fewer flops at 30k DOFs; in 2D with a Schur complement it is faster from 200k DOFs on
+(2.24 s against AMD's 2.74 s CPU on the Hertz mesh) and slower at 50k."""
 
 SolverName = Literal["newton_ac", "active_set", "projection"]
 """Local contact solvers of ``SolverOptions.chain``: semi-smooth Newton on Alart–Curnier,
