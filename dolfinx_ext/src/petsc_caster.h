@@ -61,4 +61,25 @@ public:
 
   operator Mat() { return value; }
 };
+
+/// petsc4py Vec -> PETSc Vec (arguments only: no Vec is handed back).
+template <>
+class type_caster<_p_Vec>
+{
+public:
+  PYBIND11_TYPE_CASTER(Vec, const_name("petsc4py.PETSc.Vec"));
+  bool load(handle src, bool)
+  {
+    flexcontact::require_petsc4py();
+    if (PyObject_TypeCheck(src.ptr(), &PyPetscVec_Type) == 0)
+      return false;
+    value = PyPetscVec_Get(src.ptr());
+    return true;
+  }
+  static handle cast(Vec, return_value_policy, handle)
+  {
+    throw cast_error("flexcontact: a PETSc Vec is not returned to Python");
+  }
+  operator Vec() { return value; }
+};
 } // namespace pybind11::detail
