@@ -178,6 +178,9 @@ def contact_phase(m: dict, increments: int, repeat: int) -> dict:
                                      "schur_s", "inverse_s", "ordering_s", "factor_entries",
                                      "factor_flops", "factor_memory_mb")})
     out["fstar_w_s"] = out["flexibility_s"] + out["delassus_s"]
+    # an increment is one back-substitution split around the contact solve when the factor
+    # condenses and expands (serial Schur factor), two full ones otherwise
+    out["split_increment"] = bool(info.get("condense", False))
     out["contact_dofs"] = int(problem.n_contact_dofs)
     out["pairs"] = int(problem.m)
     out["dense_mb"] = 8 * (out["contact_dofs"] ** 2 + (problem.m * m["dim"]) ** 2) / 2**20

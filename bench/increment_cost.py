@@ -1,7 +1,8 @@
 """What one load increment costs after set-up, against one back-substitution.
 
 The method's promise (docs/architecture.md §1): all heavy sparse work happens once; an increment is
-back-substitutions with the stored factor plus a small dense contact solve. On the Hertz
+one back-substitution with the stored factor (split around the contact solve; two full ones
+on several MPI ranks) plus a small dense contact solve. On the Hertz
 geometry at growing sizes this measures, in one run: the factorization with F* (a), building
 W (b), one increment (c, without writing output) and one back-substitution (d), and writes
 bench/increment_cost.json with the ratios (b)/(a) and (c)/(d).

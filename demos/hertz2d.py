@@ -8,8 +8,9 @@
 #
 # with P the load per unit length and E* = [(1−ν₁²)/E₁ + (1−ν₂²)/E₂]⁻¹. The interface nodes
 # of the two bodies face each other (node–node pairs); the initial gap R − sqrt(R² − x²)
-# enters through x0. The top is lowered in increments; each increment costs two
-# back-substitutions with the one MUMPS factorization plus the small dense contact solve.
+# enters through x0. The top is lowered in increments; each increment costs one
+# back-substitution with the one MUMPS factorization (two on several MPI ranks) plus the
+# small dense contact solve.
 #
 # Run: `/usr/bin/python3 demos/hertz2d.py [--refine N]` (also with `mpirun -n 2`).
 

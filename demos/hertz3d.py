@@ -13,7 +13,8 @@
 #
 # The interface nodes of the two bodies face each other (node–node pairs); the initial gap
 # R − sqrt(R² − r²) enters through x0. The top is lowered in increments; each increment costs
-# two back-substitutions with the one MUMPS factorization plus the dense contact solve.
+# one back-substitution with the one MUMPS factorization (two on several MPI ranks) plus the
+# dense contact solve.
 #
 # Run: `/usr/bin/python3 demos/hertz3d.py [--refine N]` (also with `mpirun -n 2`).
 

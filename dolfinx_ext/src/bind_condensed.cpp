@@ -35,6 +35,7 @@ py::dict step_dict(const CondensedStep& r, int dim)
   d["states"] = states_array(r.states);
   d["reaction"] = py::array_t<double>(r.reaction.size(), r.reaction.data());
   d["local_q"] = py::array_t<double>(r.local_q.size(), r.local_q.data());
+  d["solution_c"] = py::array_t<double>(r.solution_c.size(), r.solution_c.data());
   d["normal_force"] = r.normal_force;
   d["tangential_force"] = py::array_t<double>(r.tangential_force.size(),
                                               r.tangential_force.data());
@@ -139,10 +140,33 @@ void flexcontact::bind_condensed(py::module& m)
           "e = -R^T p then: the loads along them). Returns a dict: lambda, "
           "gap (m x d, local frames), slip (m x d-1, this increment), states (0 open, 1 "
           "stick, 2 slip), reaction (n_c, B^T lambda, zero on constrained DOFs), local_q, "
+          "solution_c (n_c, u_p,c + F* r_c: the contact values of K^-1 (p + B^T lambda)), "
           "normal_force, tangential_force (d, global), max_penetration, pair_tangential "
           "(m x d, global), alpha (rigid-mode amplitudes), undetermined (k x r directions of "
           "alpha no contact resists), report (dict). Raises ConvergenceError with .report (a dict); the "
           "history is then unchanged")
+      .def(
+          "step_condensed",
+          [convergence_error](CondensedContact& c, const Vector& b_c,
+                              const std::optional<Vector>& e)
+          {
+            CondensedStep r;
+            try
+            {
+              py::gil_scoped_release release;
+              r = c.step_condensed(b_c, e ? *e : Vector::Zero(c.rigid_modes().cols()));
+            }
+            catch (const ConvergenceError& e)
+            {
+              raise_convergence_error(convergence_error, e);
+            }
+            return step_dict(r, c.dim());
+          },
+          py::arg("b_c"), py::arg("e") = py::none(),
+          "One increment from the condensed load b_c = p_c - K_ci K_ii^-1 p_i on the contact "
+          "DOFs (SchurFactor.condense; constrained and rigid-target DOFs: their prescribed "
+          "values): u_p,c = F* b_c, then as step. The dict's solution_c (u_p,c + F* r_c) "
+          "expands to K^-1 (p + B^T lambda)")
       .def("set_flexibility", &CondensedContact::set_flexibility, py::arg("F"),
            "New F* (e.g. another time step): W is rebuilt, pairs and history kept")
       .def("set_pairs", &CondensedContact::set_pairs, py::arg("pairs"), py::arg("mu"),

@@ -12,12 +12,110 @@
 #include "flexibility.h"
 #include "petsc_caster.h"
 #include "petsc_error.h"
+#include "ordering.h"
+#include "schur_solve.h"
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <memory>
+
 namespace py = pybind11;
+using namespace flexcontact;
+
+namespace
+{
+/// @brief The factor handed to Python: a SchurFactor (condense/expand) for the serial Schur
+/// factor when its MUMPS structure is as expected, else the plain petsc4py Mat; `info` gets
+/// "condense" and, for a Schur factor that could not be split, "condense_fallback".
+py::object factor_object(Flexibility& r, std::span<const std::int64_t> dofs, py::dict& info)
+{
+  info["condense"] = false;
+  info["condense_fallback"] = "";
+  if (r.method == "schur" and r.n_contact_dofs > 0 and r.factor)
+  {
+    std::vector<PetscInt> d(dofs.begin(), dofs.end());
+    try
+    {
+      auto s = std::make_unique<SchurSolve>(r.factor, d);
+      MatDestroy(&r.factor); // s holds its own reference
+      info["condense"] = true;
+      return py::cast(std::move(s));
+    }
+    catch (const MumpsLayoutError& e)
+    {
+      info["condense_fallback"] = std::string(e.what());
+    }
+  }
+  return py::cast(r.factor, py::return_value_policy::take_ownership);
+}
+
+void bind_schur_factor(py::module& m)
+{
+  py::class_<SchurSolve>(
+      m, "SchurFactor",
+      "The serial MUMPS factor of K with a Schur complement on the contact DOFs, whose solve "
+      "splits into MUMPS's condensation (forward elimination) and expansion (backward "
+      "substitution). Other attributes are the petsc4py Mat's (`mat`).")
+      .def_property_readonly("has_condense", [](const SchurSolve&) { return true; },
+                             "True: condense and expand exist")
+      .def_property_readonly("n_contact_dofs", &SchurSolve::size)
+      .def_property_readonly(
+          "mat",
+          [](const SchurSolve& s)
+          {
+            if (!s.mat())
+              throw std::logic_error("the MUMPS factor was destroyed");
+            return s.mat();
+          },
+          py::return_value_policy::reference_internal, "The factor as a petsc4py Mat")
+      .def(
+          "solve",
+          [](SchurSolve& s, Vec b, Vec x)
+          {
+            py::gil_scoped_release release;
+            s.solve(b, x);
+          },
+          py::arg("b"), py::arg("x"), "x = K^-1 b (a full solve). Collective.")
+      .def(
+          "condense",
+          [](SchurSolve& s, Vec b)
+          {
+            std::vector<double> c;
+            {
+              py::gil_scoped_release release;
+              c = s.condense(b);
+            }
+            return py::array_t<double>(c.size(), c.data());
+          },
+          py::arg("b"),
+          "MUMPS's condensation of b (forward elimination): the reduced right-hand side "
+          "b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order given to flexibility. "
+          "MUMPS keeps the interior's part for the next expand. Collective.")
+      .def(
+          "expand",
+          [](SchurSolve& s, py::array_t<double, py::array::c_style | py::array::forcecast> u_c,
+             Vec x)
+          {
+            std::span<const double> u(u_c.data(), u_c.size());
+            py::gil_scoped_release release;
+            s.expand(u, x);
+          },
+          py::arg("u_c"), py::arg("x"),
+          "MUMPS's expansion (backward substitution): x = the solution of K x = b, b of the "
+          "last condense, whose contact values are u_c (K^-1 b when u_c = F* of the condensed "
+          "b). Once per condense. Collective.")
+      .def("destroy", &SchurSolve::destroy, "Release the factor")
+      .def("__getattr__",
+           [](const SchurSolve& s, const std::string& name) -> py::object
+           {
+             if (!s.mat())
+               throw py::attribute_error(name);
+             return py::cast(s.mat(), py::return_value_policy::reference).attr(name.c_str());
+           });
+}
+} // namespace
 
 namespace
 {
@@ -90,6 +188,7 @@ void bind_distributed_schur(py::module& m)
 
 void flexcontact::bind_petsc(py::module& m)
 {
+  bind_schur_factor(m);
   py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError",
                                                  PyExc_RuntimeError);
   py::register_exception<MumpsError>(m, "MumpsError", PyExc_RuntimeError);
@@ -128,9 +227,15 @@ void flexcontact::bind_petsc(py::module& m)
         info["n_blocks"] = r.n_blocks;
         info["block_sizes"] = r.block_sizes;
         info["blocks_s"] = r.blocks_s;
-        py::object factor = r.distributed
-                                ? py::cast(r.distributed)
-                                : py::cast(r.factor, py::return_value_policy::take_ownership);
+        py::object factor;
+        if (r.distributed)
+        {
+          info["condense"] = true;
+          info["condense_fallback"] = "";
+          factor = py::cast(r.distributed);
+        }
+        else
+          factor = factor_object(r, dofs, info);
         py::array_t<double> F = py::cast(r.F);
         return py::make_tuple(F, factor, info);
       },
@@ -155,8 +260,10 @@ touching contact); F* is block-diagonal by them and only the blocks are computed
 each block of K*_cc inverted on its own; "inverse_entries": only entries within blocks asked
 of MUMPS). False: one block of all contact DOFs (the same F* up to rounding).
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
-factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made (a
-petsc4py Mat, or on several ranks with "schur" a DistributedSchur); info:
+factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; with
+"schur" a SchurFactor on one process, a DistributedSchur on several (factor.has_condense:
+factor.condense(b) and factor.expand(u_c, x) split a solve in two halves), else a petsc4py
+Mat; info:
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
 workspace), factorization_s,
 schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s, ordering
@@ -165,7 +272,8 @@ ordering: this PETSc's MUMPS factor cannot take ours; empty otherwise), ordering
 part of factorization_s), analysis_s (PETSc's own MUMPS analysis, part of factorization_s),
 factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
 factor_memory_mb (INFOG(22)), n_blocks, block_sizes (contact DOFs per block, rank 0),
-blocks_s (finding the blocks).
+blocks_s (finding the blocks), condense (factor is a SchurFactor), condense_fallback (why a
+serial Schur factor could not be split: this PETSc's MUMPS structure; empty otherwise).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
 

@@ -192,6 +192,20 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c)
   return step(up_c, Vector::Zero(R_.cols()));
 }
 
+CondensedStep CondensedContact::step_condensed(const Eigen::Ref<const Vector>& b_c,
+                                               const Eigen::Ref<const Vector>& e)
+{
+  if (b_c.size() != F_.rows())
+    throw std::invalid_argument(who + "step_condensed: b_c has " + std::to_string(b_c.size())
+                                + " entries, expected n_c = " + std::to_string(F_.rows()));
+  // F_ has the constrained rows and columns zeroed; K's identity rows give them F* = 1.
+  Vector up_c = F_ * b_c;
+  for (std::size_t i = 0; i < constrained_.size(); ++i)
+    if (constrained_[i])
+      up_c[static_cast<Eigen::Index>(i)] = b_c[static_cast<Eigen::Index>(i)];
+  return step(up_c, e);
+}
+
 CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
                                      const Eigen::Ref<const Vector>& e)
 {
@@ -247,8 +261,9 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
   for (std::size_t i = 0; i < constrained_.size(); ++i)
     if (constrained_[i])
       r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+  r.solution_c = up_c + F_ * r.reaction;
   // Kept for re-pairing: the gap of new pairs at this displacement is their slip origin.
-  u_c_ = up_c + F_ * r.reaction;
+  u_c_ = r.solution_c;
   if (R_.cols())
     u_c_ += R_ * r.alpha;
   return r;

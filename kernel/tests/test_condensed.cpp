@@ -265,3 +265,29 @@ TEST(Condensed, BadSizesAreNamed)
            [&] { c.step(vec({0.0})); }})
     EXPECT_THROW(make(), std::invalid_argument);
 }
+
+TEST(Condensed, CondensedLoadGivesTheSameIncrementAndItsSolution)
+{
+  // step_condensed(b) is step(F* b) with the held DOFs' entries taken as given; solution_c
+  // is u_p,c + F* r_c, the contact values of K⁻¹ (p + Bᵀ λ).
+  const Matrix F = random_spd(4, 10.0, 13);
+  CondensedContact a(2, F, X2, one_pair(), vec({0.3}), master_held);
+  CondensedContact b(2, F, X2, one_pair(), vec({0.3}), master_held);
+  const Vector load = vec({0.2, -40.0, 0.01, -0.02}); // the held master moved by (0.01, −0.02)
+  Matrix Fz = F;
+  Fz.rightCols(2).setZero();
+  Fz.bottomRows(2).setZero();
+  Vector up_c = Fz * load;
+  up_c.tail(2) = load.tail(2);
+  const CondensedStep r = a.step_condensed(load, Vector::Zero(0));
+  const CondensedStep s = b.step(up_c);
+  EXPECT_GT(s.lambda[0], 0.0);
+  EXPECT_LT((r.lambda - s.lambda).norm(), 1e-14 * s.lambda.norm());
+  EXPECT_LT((r.local_q - s.local_q).norm(), 1e-14 * s.local_q.norm());
+  const Vector u_c = up_c + Fz * s.reaction;
+  EXPECT_LT((r.solution_c - u_c).norm(), 1e-14 * u_c.norm());
+  EXPECT_LT((s.solution_c - u_c).norm(), 1e-14 * u_c.norm());
+  EXPECT_EQ(r.solution_c[2], 0.01);
+  EXPECT_EQ(r.solution_c[3], -0.02);
+  EXPECT_THROW(a.step_condensed(vec({1.0, 2.0}), Vector::Zero(0)), std::invalid_argument);
+}

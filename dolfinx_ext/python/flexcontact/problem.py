@@ -4,7 +4,9 @@ The flow is one-directional (docs/architecture.md §2), one module per stage: ``
 ``pairing`` (node pairs of the contact interfaces), ``condensation`` (one MUMPS
 factorization gives F* = (K⁻¹)_cc on the contact DOFs; the kernel object holds B, x0,
 W = B F* Bᵀ and solves x = W λ + q per increment), ``postprocess`` (summaries and the
-contact fields). u = K⁻¹ (p + Bᵀ λ) comes from the same factor.
+contact fields). u = K⁻¹ (p + Bᵀ λ) comes from the same factor: with MUMPS's Schur factor
+(serial) an increment is one back-substitution, p condensed onto the contact DOFs before
+the contact solve and the solution expanded after it.
 """
 from __future__ import annotations
 
@@ -37,6 +39,7 @@ if TYPE_CHECKING:
     import ufl
     from dolfinx.fem import DirichletBC
     from dolfinx.mesh import MeshTags
+    from petsc4py import PETSc
 
 
 ZONE_EDGE_ACTIONS = ("warn", "error", "ignore")
@@ -267,9 +270,17 @@ class ContactProblem:
         if self.floating is not None:
             e = self.floating.loads(p)       # −Rᵀp, before K⁺ drops the fixing DOFs' loads
             self.floating.zero_fixed(p)
-        up = self.K.createVecRight()
-        self.factor.solve(p, up)
-        upc = self.condensation.gather(up)
+        # With a factor that splits its solves, p is only condensed onto the contact DOFs
+        # here (forward elimination) and the kernel forms u_p,c = F* p̃_c; the expansion
+        # below finishes the increment's one back-substitution (protocol in schur_solve.h).
+        split = getattr(self.factor, "has_condense", False)
+        up = None
+        if split:
+            upc = self.factor.condense(p)
+        else:
+            up = self.K.createVecRight()
+            self.factor.solve(p, up)
+            upc = self.condensation.gather(up)
         if root:
             upc = self.condensation.contact_values(upc)
         out, failure = None, None
@@ -277,7 +288,8 @@ class ContactProblem:
             try:
                 t1 = time.perf_counter()
                 # the increment's one crossing into the kernel
-                out = self.contact.step(upc) if e is None else self.contact.step(upc, e)
+                step = self.contact.step_condensed if split else self.contact.step
+                out = step(upc) if e is None else step(upc, e)
                 # the local contact solve alone, for bench/ (the rest is sparse work)
                 self.timings["last_contact_step_s"] = time.perf_counter() - t1
                 q = out["local_q"]
@@ -296,21 +308,18 @@ class ContactProblem:
         failure = self.comm.bcast(failure, root=0)
         if failure:
             for v in (p, up):
-                v.destroy()
+                if v is not None:
+                    v.destroy()
             if failure[1] is None:
                 raise ValueError(failure[0])
             error = (NoEquilibriumError if failure[2] else ConvergenceError)(failure[0])
             error.report = failure[1]  # what the solvers did, on every rank
             raise error
-        r = self.condensation.reaction(out["reaction"] if root else None)
-        r.axpy(1.0, p)
-        self.factor.solve(r, compat.petsc_vec(self.u))
+        self._solution(p, up, out, split)
         if self.floating is not None:
             alpha = self.comm.bcast(out["alpha"] if root else None, root=0)
             self.floating.add_modes(compat.petsc_vec(self.u), alpha)
         self.u.x.scatter_forward()
-        for v in (p, up, r):
-            v.destroy()
         inc = record_increment(out, number, self.u, self.comm, self.dim,
                                time.perf_counter() - t0)
         self.increments.append(inc)
@@ -320,6 +329,26 @@ class ContactProblem:
         self.outputs.write_back(inc, self.pairs)
         self._guard_zone(inc)
         return inc
+
+    def _solution(self, p: PETSc.Vec, up: Optional[PETSc.Vec], out: Optional[dict],
+                  split: bool) -> None:
+        """u = K⁻¹ (p + Bᵀ λ) (K⁺ for bodies held only by contact) into self.u: the expansion
+        of the condensed p from the contact values u_p,c + F* r_c (the kernel's
+        ``solution_c``; Bᵀ λ lives on the contact DOFs, so p's forward elimination serves),
+        or a second solve with a factor that cannot split. Destroys p and up."""
+        root = self.comm.rank == 0
+        if split:
+            n = self.condensation.dofs.size
+            uc = np.asarray(out["solution_c"])[:n] if root else np.zeros(0)
+            self.factor.expand(uc, compat.petsc_vec(self.u))
+        else:
+            r = self.condensation.reaction(out["reaction"] if root else None)
+            r.axpy(1.0, p)
+            self.factor.solve(r, compat.petsc_vec(self.u))
+            r.destroy()
+        for v in (p, up):
+            if v is not None:
+                v.destroy()
 
     def _no_equilibrium(self, number: int, e: np.ndarray, failure: tuple) -> tuple:
         """The failure of a bordered increment, with the body and mode that no contact force

@@ -28,6 +28,9 @@ struct CondensedStep
   std::vector<PairState> states;  ///< per pair
   SolveReport report;             ///< what the local solver did
   Vector reaction;                ///< n_c, r_c = Bᵀ λ; zero on constrained contact DOFs
+  /// n_c, u_p,c + F* r_c: the contact values of K⁻¹ (p + Bᵀ λ) (K⁺ with rigid modes: R_c α
+  /// not included), from which a solver that split K⁻¹ p expands the full displacement
+  Vector solution_c;
   Vector local_q;                 ///< q' of the local problem u = W λ + q' that was solved
   double normal_force = 0.0;      ///< Σ_k λ_n,k
   Vector tangential_force;        ///< d, Σ_k T_kᵀ (0, λ_t,k): the total friction force
@@ -68,6 +71,15 @@ public:
   /// rigid modes; the gap is W λ + q + G α with G = B R_c, and Gᵀ λ = e.
   /// @throws as step(up_c); std::invalid_argument if e's size is not the mode count
   CondensedStep step(const Eigen::Ref<const Vector>& up_c, const Eigen::Ref<const Vector>& e);
+
+  /// @brief One increment from the condensed load b̃_c = p_c − K_ci K_ii⁻¹ p_i on the contact
+  /// DOFs (a sparse solver's condensation of p), u_p,c = F* b̃_c computed here: the same as
+  /// step(F* b̃_c, e). A constrained contact DOF's entry is its prescribed value, taken as is
+  /// (its row of K is the identity, as assembled with Dirichlet conditions; a rigid target's
+  /// virtual DOF likewise).
+  /// @throws as step(up_c, e); std::invalid_argument if b_c has the wrong size
+  CondensedStep step_condensed(const Eigen::Ref<const Vector>& b_c,
+                               const Eigen::Ref<const Vector>& e);
 
   /// @brief Rigid modes R_c (n_c × k: the values at the contact DOFs of the free rigid modes
   /// of the bodies held only by contact); G = B R_c is kept up to date with the pairs.
