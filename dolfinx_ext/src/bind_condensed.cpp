@@ -26,31 +26,6 @@ using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
 using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 using RealArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-py::dict step_dict(const CondensedStep& r, int dim)
-{
-  py::dict d;
-  d["lambda"] = rows_of(r.lambda, dim);
-  d["gap"] = rows_of(r.gap, dim);
-  d["slip"] = rows_of(r.slip, dim - 1);
-  d["states"] = states_array(r.states);
-  d["reaction"] = py::array_t<double>(r.reaction.size(), r.reaction.data());
-  d["local_q"] = py::array_t<double>(r.local_q.size(), r.local_q.data());
-  d["solution_c"] = py::array_t<double>(r.solution_c.size(), r.solution_c.data());
-  d["normal_force"] = r.normal_force;
-  d["tangential_force"] = py::array_t<double>(r.tangential_force.size(),
-                                              r.tangential_force.data());
-  d["max_penetration"] = r.max_penetration;
-  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> t
-      = r.pair_tangential;
-  d["pair_tangential"] = py::array_t<double>({t.rows(), t.cols()}, t.data());
-  d["report"] = report_dict(r.report);
-  d["alpha"] = py::array_t<double>(r.alpha.size(), r.alpha.data());
-  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> n
-      = r.undetermined;
-  d["undetermined"] = py::array_t<double>({n.rows(), n.cols()}, n.data());
-  return d;
-}
-
 std::vector<bool> flags(const std::optional<BoolArray>& a)
 {
   if (!a)
@@ -133,7 +108,7 @@ void flexcontact::bind_condensed(py::module& m)
             {
               raise_convergence_error(convergence_error, e);
             }
-            return step_dict(r, c.dim());
+            return condensed_step_dict(r, c.dim());
           },
           py::arg("up_c"), py::arg("e") = py::none(),
           "One increment from the contact-DOF values of u_p = K^-1 p (K^+ p with rigid modes, "
@@ -160,7 +135,7 @@ void flexcontact::bind_condensed(py::module& m)
             {
               raise_convergence_error(convergence_error, e);
             }
-            return step_dict(r, c.dim());
+            return condensed_step_dict(r, c.dim());
           },
           py::arg("b_c"), py::arg("e") = py::none(),
           "One increment from the condensed load b_c = p_c - K_ci K_ii^-1 p_i on the contact "

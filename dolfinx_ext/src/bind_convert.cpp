@@ -5,6 +5,8 @@
 
 #include "bindings.h"
 
+#include <flexcontact/condensed.hpp>
+
 #include <pybind11/stl.h>
 
 #include <cstring>
@@ -67,5 +69,30 @@ void raise_convergence_error(py::handle cls, const ConvergenceError& e)
   error.attr("report") = report_dict(e.report);
   PyErr_SetObject(cls.ptr(), error.ptr());
   throw py::error_already_set();
+}
+
+py::dict condensed_step_dict(const CondensedStep& r, int dim)
+{
+  py::dict d;
+  d["lambda"] = rows_of(r.lambda, dim);
+  d["gap"] = rows_of(r.gap, dim);
+  d["slip"] = rows_of(r.slip, dim - 1);
+  d["states"] = states_array(r.states);
+  d["reaction"] = py::array_t<double>(r.reaction.size(), r.reaction.data());
+  d["local_q"] = py::array_t<double>(r.local_q.size(), r.local_q.data());
+  d["solution_c"] = py::array_t<double>(r.solution_c.size(), r.solution_c.data());
+  d["normal_force"] = r.normal_force;
+  d["tangential_force"] = py::array_t<double>(r.tangential_force.size(),
+                                              r.tangential_force.data());
+  d["max_penetration"] = r.max_penetration;
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> t
+      = r.pair_tangential;
+  d["pair_tangential"] = py::array_t<double>({t.rows(), t.cols()}, t.data());
+  d["report"] = report_dict(r.report);
+  d["alpha"] = py::array_t<double>(r.alpha.size(), r.alpha.data());
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> n
+      = r.undetermined;
+  d["undetermined"] = py::array_t<double>({n.rows(), n.cols()}, n.data());
+  return d;
 }
 } // namespace flexcontact

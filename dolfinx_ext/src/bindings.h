@@ -24,6 +24,10 @@ void bind_kernel(pybind11::module& m);
 /// @brief The condensed contact problem (called by bind_kernel, after ConvergenceError).
 void bind_condensed(pybind11::module& m);
 
+/// @brief The condensed contact problem with W applied through the factor of K
+/// (kernel/.../operator_contact.hpp, factor_operator.h); after bind_kernel and bind_petsc.
+void bind_operator(pybind11::module& m);
+
 /// @brief The Moreau–Jean contact step (kernel/.../impact.hpp).
 void bind_impact(pybind11::module& m);
 
@@ -38,6 +42,9 @@ pybind11::array_t<int> states_array(const std::vector<PairState>& s);
 
 /// @brief The pairs' local frames T_k as an m × d × d array (rows n, t (, t2)).
 pybind11::array_t<double> frames_array(const std::vector<ContactPair>& pairs, int dim);
+
+/// @brief One increment of the condensed problem as a dict of NumPy arrays and numbers.
+pybind11::dict condensed_step_dict(const struct CondensedStep& r, int dim);
 
 /// @brief What a solver did, as a dict.
 pybind11::dict report_dict(const SolveReport& r);

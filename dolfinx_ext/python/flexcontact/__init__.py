@@ -25,6 +25,7 @@ from .problem import (ContactInterface, ContactProblem, ContactZoneError, Contac
 from .rigid import RigidTarget
 from .floating import FreeModeWarning, NoEquilibriumError, TippingWarning
 from .dynamics import ImpactProblem, ImpactStepRecord
+from .memory import ContactMemoryError
 
 __version__ = "0.1.0"
 
@@ -36,6 +37,6 @@ __all__ = [
     "FlexibilityMethod", "SolverName", "FLEXIBILITY_METHODS", "SOLVER_NAMES", "Ordering",
     "ORDERINGS",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",
-    "NoEquilibriumError", "FreeModeWarning", "TippingWarning",
+    "NoEquilibriumError", "FreeModeWarning", "TippingWarning", "ContactMemoryError",
     "__version__",
 ]

@@ -14,6 +14,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from . import _cpp, compat
+from .memory import check_dense_memory_collective
 from .pairing import NodePairs
 
 
@@ -64,6 +65,9 @@ class Condensation:
         self._template = K
         constrained = self._constrained_mask(K, bcs)
 
+        # Before MUMPS allocates the Schur complement (memory.py).
+        check_dense_memory_collective(comm, self.dofs.size + self.n_virtual_dofs if root else None,
+                                      pairs.m if root else None, dim)
         self.timings = {}
         t0 = time.perf_counter()
         F, self.factor, info = _cpp.flexibility(K, self.dofs, method, ordering)

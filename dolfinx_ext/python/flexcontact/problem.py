@@ -24,6 +24,7 @@ from . import compat
 from ._cpp import ConvergenceError, SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
+from . import factor_path
 from .mpi import raise_on_every_rank
 from .names import FlexibilityMethod, Ordering, check_chain, check_flexibility_method, \
     check_ordering
@@ -177,6 +178,11 @@ class ContactProblem:
         is measured from where it now is on the master. False keeps the pairs of the
         reference positions (each slave node tied to a fixed master point; for comparisons
         and small slips).
+    contact_operator : "dense" (default): F* and W = B F* Bᵀ formed densely (8·n_c² and
+        8·(m·d)² bytes on rank 0; a ContactMemoryError before any allocation when they would
+        not fit), the local solver chain on W. "factor": one plain factorization, W applied
+        through it (one back-substitution per product), an iterative local solver on W·x:
+        O(n_c) memory for large contact sets, slower per increment (docs/large_contact.md).
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.
@@ -191,8 +197,11 @@ class ContactProblem:
                  bodies: Optional[tuple[MeshTags, dict[str, int]]] = None,
                  stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
                  flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto",
-                 repair_pairs: bool = True, floating: bool = False):
+                 repair_pairs: bool = True, floating: bool = False,
+                 contact_operator: str = "dense"):
         check_flexibility_method(flexibility)
+        factor_path.check_contact_operator(contact_operator, floating)
+        self.contact_operator = contact_operator
         if not isinstance(repair_pairs, (bool, np.bool_)):
             raise ValueError(f"repair_pairs={repair_pairs!r}; it must be True or False")
         check_ordering(ordering)
@@ -239,9 +248,14 @@ class ContactProblem:
         self.repairing = bool(repair_pairs) and any(i.pairing_used != "node_to_node"
                                                     for i in self.interfaces)
         self.pairings = 1
-        self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
-                                         self.comm, self.options, self.flexibility_method,
-                                         ordering=self.ordering)
+        if contact_operator == "factor":
+            self.condensation = factor_path.FactorCondensation(
+                self.K, self.bcs, self.pairs, self.mu, self.dim, self.comm, self.options,
+                ordering=self.ordering)
+        else:
+            self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
+                                             self.comm, self.options, self.flexibility_method,
+                                             ordering=self.ordering)
         c = self.condensation
         self.factorizations = c.factorizations
         self.timings.update(c.timings)
@@ -260,6 +274,8 @@ class ContactProblem:
     # ---- one increment ---------------------------------------------------------------
     def step(self) -> IncrementResult:
         """Solve one increment with the loads and Dirichlet values as they are set now."""
+        if self.contact_operator == "factor":
+            return factor_path.step(self)
         t0 = time.perf_counter()
         root = self.comm.rank == 0
         number = len(self.increments) + 1

@@ -1,0 +1,172 @@
+"""The condensed contact problem without a dense W: ``ContactProblem(contact_operator="factor")``.
+
+One plain MUMPS factorization of K (no Schur complement, no F*); W x = B (K⁻¹ Bᵀ x)_c is
+applied through that factor, one back-substitution per product, and the local problem is
+solved by an accelerated projected fixed point that needs only W·x (kernel's
+operator_contact.hpp). Memory is the factor's plus O(n_c + m·d); each increment costs one
+back-substitution per iteration of the local solver (a few hundred), against the dense
+path's set-up of n_c solves and (m·d)² storage. bench/large_contact.py measures the
+crossover; docs/large_contact.md says when to use which.
+
+In parallel every rank holds the kernel object and runs the same deterministic iteration on
+replicated contact vectors; each product is a collective MatSolve.
+"""
+from __future__ import annotations
+
+import time
+from typing import Optional, Sequence
+
+import numpy as np
+from petsc4py import PETSc
+
+from . import _cpp, compat
+from ._cpp import ConvergenceError
+from .assembly import assemble_load
+from .condensation import Condensation
+from .mpi import raise_on_every_rank
+from .postprocess import IncrementResult, record_increment
+
+CONTACT_OPERATORS = ("dense", "factor")
+
+
+def check_contact_operator(value, floating: bool) -> None:
+    """A clear error for an unknown contact_operator, or one the options cannot use."""
+    if value not in CONTACT_OPERATORS:
+        raise ValueError(f"contact_operator={value!r}; it must be one of "
+                         f"{', '.join(map(repr, CONTACT_OPERATORS))}")
+    if value == "factor" and floating:
+        raise ValueError("contact_operator='factor' does not handle bodies held only by "
+                         "contact (floating=True); use contact_operator='dense'")
+
+
+def _pair_arrays(pairs) -> tuple:
+    """What the kernel's pairs are made of, picklable (rank 0's pairs to every rank)."""
+    return (int(pairs.m), np.asarray(pairs.masters), np.asarray(pairs.weights),
+            np.asarray(pairs.normal), np.asarray(pairs.offset))
+
+
+def _kernel_pairs(arrays: tuple) -> list:
+    m, masters, weights, normal, offset = arrays
+    return _cpp.pairs_from_normals(np.arange(m), masters, weights, normal, offset)
+
+
+class FactorCondensation(Condensation):
+    """The plain factor of K and the kernel's ``FactorContact`` (on every rank).
+
+    Read as Condensation is: ``contact``, ``factor``, ``flex_info``, ``B``, ``x0``,
+    ``frames`` (rank 0), gather/reaction/contact_values; ``W`` is None (never formed).
+    """
+
+    def __init__(self, K: PETSc.Mat, bcs: Sequence, pairs, mu: Optional[np.ndarray],
+                 dim: int, comm, options, ordering: str = "auto"):
+        self.comm = comm
+        root = comm.rank == 0
+        self.pairs = pairs
+        n_virtual = getattr(pairs, "n_virtual", 0) if root else 0
+        real = pairs.dofs[:pairs.dofs.shape[0] - n_virtual] if root else None
+        self.dofs = (real.reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
+        self.n_virtual_dofs = comm.bcast(n_virtual * dim, root=0)
+        is_from = PETSc.IS().createGeneral(self.dofs.astype(PETSc.IntType), comm=comm)
+        self._seq = PETSc.Vec().createSeq(self.dofs.size, comm=PETSc.COMM_SELF)
+        is_to = PETSc.IS().createStride(self.dofs.size, 0, 1, comm=PETSc.COMM_SELF)
+        self._scatter = PETSc.Scatter().create(K.createVecLeft(), is_from, self._seq, is_to)
+        self._template = K
+        constrained = self._constrained_mask(K, bcs)
+        if root and self.n_virtual_dofs:
+            constrained = np.concatenate([constrained, np.ones(self.n_virtual_dofs, bool)])
+
+        self.timings = {}
+        t0 = time.perf_counter()
+        # No contact DOFs asked: one plain factorization, no Schur complement. Not "schur":
+        # on several ranks that is a DistributedSchur, and the products need PETSc's Mat.
+        _, self.factor, info = _cpp.flexibility(K, np.zeros(0, np.int64), "inverse_entries",
+                                                ordering)
+        self.timings["flexibility_s"] = time.perf_counter() - t0
+        self.flex_info = dict(info, method="factor")
+        self.factorizations = 1
+        self.n_contact_dofs = comm.bcast(self.dofs.size if root else None, root=0)
+
+        dofs, x, arrays, mu, constrained = comm.bcast(
+            (self.dofs, np.asarray(pairs.x), _pair_arrays(pairs), np.asarray(mu), constrained)
+            if root else None, root=0)
+        t0 = time.perf_counter()
+        self.contact = _cpp.FactorContact(dim, self.factor.handle, K.handle, dofs,
+                                          self.n_virtual_dofs, x,
+                                          _kernel_pairs(arrays), mu, constrained, options)
+        self.timings["delassus_s"] = time.perf_counter() - t0  # the ‖W‖ and ρ estimates
+        self.W = None
+        self._operators()
+
+    def _operators(self):
+        root = self.comm.rank == 0
+        c = self.contact
+        self.B, self.x0, self.frames = (c.B, c.x0, c.frames) if root else (None, None, None)
+
+    def set_pairs(self, pairs, mu) -> None:
+        """New pairs on the same contact nodes (rank 0's pairs and mu). Collective."""
+        root = self.comm.rank == 0
+        self.pairs = pairs
+        arrays, mu = self.comm.bcast((_pair_arrays(pairs), np.asarray(mu)) if root else None,
+                                     root=0)
+        self.contact.set_pairs(_kernel_pairs(arrays), mu)
+        self._operators()
+
+
+def repair(pb) -> None:
+    """ContactProblem.repair for the factor path: every rank sets the new pairs."""
+    uc = pb.condensation.gather(compat.petsc_vec(pb.u))
+    error = None
+    if pb.comm.rank == 0:
+        try:
+            pb.pairs.repair(pb.condensation.contact_values(uc))
+        except ValueError as e:
+            error = f"increment {len(pb.increments) + 1}: re-pairing: {e}"
+    raise_on_every_rank(pb.comm, error)
+    c = pb.condensation
+    c.set_pairs(pb.pairs, pb.mu)
+    pb.B, pb.x0, pb.frames = c.B, c.x0, c.frames
+    pb.pairings += 1
+
+
+def step(pb) -> IncrementResult:
+    """ContactProblem.step for the factor path (same result, same errors)."""
+    t0 = time.perf_counter()
+    root = pb.comm.rank == 0
+    number = len(pb.increments) + 1
+    if pb.repairing:
+        repair(pb)
+    p = assemble_load(pb.V, pb.a_form, pb.L_form, pb.bcs, pb.comm)
+    up = pb.K.createVecRight()
+    pb.factor.solve(p, up)
+    upc = pb.condensation.gather(up)
+    upc = pb.comm.bcast(pb.condensation.contact_values(upc) if root else None, root=0)
+    out, failure = None, None
+    try:
+        t1 = time.perf_counter()
+        out = pb.contact.step(upc)  # collective: every rank runs the same iteration
+        pb.timings["last_contact_step_s"] = time.perf_counter() - t1
+    except ConvergenceError as err:
+        failure = (f"increment {number}: {err}", dict(getattr(err, "report", {})))
+    except ValueError as err:
+        failure = (f"increment {number}: {err}", None)
+    failure = pb.comm.bcast(failure, root=0)
+    if failure:
+        for v in (p, up):
+            v.destroy()
+        if failure[1] is None:
+            raise ValueError(failure[0])
+        error = ConvergenceError(failure[0])
+        error.report = failure[1]
+        raise error
+    r = pb.condensation.reaction(out["reaction"] if root else None)
+    r.axpy(1.0, p)
+    pb.factor.solve(r, compat.petsc_vec(pb.u))
+    pb.u.x.scatter_forward()
+    for v in (p, up, r):
+        v.destroy()
+    inc = record_increment(out if root else None, number, pb.u, pb.comm, pb.dim,
+                           time.perf_counter() - t0)
+    pb.increments.append(inc)
+    pb.outputs.write_back(inc, pb.pairs)
+    pb._guard_zone(inc)
+    return inc
