@@ -153,7 +153,7 @@ def mpi_section(m: dict | None) -> list[str]:
     if not m:
         return []
     out = ["## Serial against `mpirun -n 2` (issue 18, item 5)", "",
-           "The largest 2D and 3D cases of the default set, on one process and on two "
+           "The largest 2D and 3D cases of the run, on one process and on two "
            "(`bench/run.py --mpi`), back to back. Speed-up = serial time / two-rank time; "
            "answers: max |u₂ − u₁| / max |u₁| over all nodes (likewise the contact pressure "
            "and each increment's normal force).", "",

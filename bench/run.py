@@ -12,7 +12,7 @@ back-substitution: (d)), then flexcontact's ContactProblem (F* and W: (b); load
 increments: (c); the local contact solve), each phase's peak memory measured on its own.
 Ratios are taken within the run; the report checks the targets of the large meshes.
 
-With --mpi the largest 2D and 3D cases of the default set run again, serial and with
+With --mpi the largest 2D and 3D cases (--mpi-cases) run again, serial and with
 `mpirun -n 2` back to back, and the report gives each phase's speed-up and the largest
 difference of the answers (u, contact pressure, normal force), next to what two processes
 can gain on this machine at all (bench/mpi_ceiling.py's bench/mpi_ceiling.json).
@@ -157,8 +157,8 @@ def run_peers(args) -> dict:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--full", action="store_true", help="the full set (2D to ≥ 1M, 3D to 390k "
-                    "DOFs; estimated 1.5 hours more and up to about 10 GB)")
+    ap.add_argument("--full", action="store_true", help="the full set (2D to ≥ 1M, 3D to 415k "
+                    "DOFs; about 12 min more on the quiet machine, up to 8.3 GB)")
     ap.add_argument("--cases", nargs="+", choices=list(CASES), help="run these cases only")
     ap.add_argument("--increments", type=int, default=4, help="load increments per case")
     ap.add_argument("--repeat", type=int, default=5, help="back-substitutions timed (median)")
