@@ -7,6 +7,7 @@
 #include "constrained.hpp"
 #include "flexcontact/condensed.hpp"
 #include "python_float.hpp"
+#include "step_summary.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -238,29 +239,7 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
   r.gap = solver_.gap();
   r.states = solver_.states();
 
-  const int m = pairs(), d = dim_;
-  r.slip.resize(m * (d - 1));
-  r.pair_tangential = Matrix::Zero(m, d);
-  r.normal_force = 0.0;
-  double min_gap = 0.0;
-  for (int k = 0; k < m; ++k)
-  {
-    r.normal_force += r.lambda[k * d];
-    min_gap = std::min(min_gap, r.gap[k * d]);
-    for (int j = 1; j < d; ++j)
-    {
-      r.slip[k * (d - 1) + j - 1] = r.gap[k * d + j] - previous[k * d + j];
-      // The friction force in global axes: the tangent rows of T_k carry λ_t back.
-      r.pair_tangential.row(k) += r.lambda[k * d + j] * pairs_[k].frame.row(j);
-    }
-  }
-  r.tangential_force = r.pair_tangential.colwise().sum().transpose();
-  r.max_penetration = std::max(0.0, -min_gap);
-
-  r.reaction = B_.transpose() * r.lambda;
-  for (std::size_t i = 0; i < constrained_.size(); ++i)
-    if (constrained_[i])
-      r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+  detail::summarize_step(r, pairs_, dim_, previous, B_, constrained_);
   r.solution_c = up_c + F_ * r.reaction;
   // Kept for re-pairing: the gap of new pairs at this displacement is their slip origin.
   u_c_ = r.solution_c;

@@ -5,6 +5,7 @@
 /// applied and never formed.
 
 #include "flexcontact/operator_contact.hpp"
+#include "step_summary.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -145,25 +146,7 @@ CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
     for (int j = 1; j < d; ++j)
       r.gap[k * d + j] += x_[k * d + j];
   r.states = r.report.states;
-  r.slip.resize(m * (d - 1));
-  r.pair_tangential = Matrix::Zero(m, d);
-  double min_gap = 0.0;
-  for (int k = 0; k < m; ++k)
-  {
-    r.normal_force += r.lambda[k * d];
-    min_gap = std::min(min_gap, r.gap[k * d]);
-    for (int j = 1; j < d; ++j)
-    {
-      r.slip[k * (d - 1) + j - 1] = r.gap[k * d + j] - x_[k * d + j];
-      r.pair_tangential.row(k) += r.lambda[k * d + j] * pairs_[k].frame.row(j);
-    }
-  }
-  r.tangential_force = r.pair_tangential.colwise().sum().transpose();
-  r.max_penetration = std::max(0.0, -min_gap);
-  r.reaction = B_.transpose() * r.lambda;
-  for (std::size_t i = 0; i < constrained_.size(); ++i)
-    if (constrained_[i])
-      r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+  detail::summarize_step(r, pairs_, d, x_, B_, constrained_);
   r.alpha = Vector::Zero(0);
   r.undetermined = Matrix::Zero(0, 0);
   x_ = r.gap;
