@@ -29,7 +29,7 @@ from random_problems import SOLVERS, run_flexcontact, run_siconos, sample  # noq
 
 ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 ap.add_argument("--count", type=int, default=10000, help="problems with up to 60 pairs")
-ap.add_argument("--large", type=int, default=4, help="problems with 300-1000 pairs (minutes each)")
+ap.add_argument("--large", type=int, default=8, help="problems with 300-1000 pairs (minutes each)")
 ap.add_argument("--seed", type=int, default=1)
 ap.add_argument("--tolerance", type=float, default=1e-10)
 ap.add_argument("--no-siconos", action="store_true")

@@ -118,11 +118,19 @@ def sample(seed: int, count: int, sizes=(1, 60), large: int = 0, large_m=(300, 1
     rng = np.random.default_rng(seed)
     out = []
     for i in range(count + large):
-        kind = CLASSES[i % len(CLASSES)]
-        dim = 2 + (i // len(CLASSES)) % 2
+        kind, dim = kind_and_dim(i, count)
         lo, hi = sizes if i < count else large_m
         out.append(make_problem(rng, kind, dim, int(rng.integers(lo, hi + 1)), i))
     return out
+
+
+def kind_and_dim(i: int, count: int) -> tuple:
+    """Class and dimension of problem i: the classes in turn, 2D and 3D in alternate rounds
+    of them; the large ones (i ≥ count) alternate 2D/3D within a round too, so that even a
+    few of them reach the 3D sizes (3,000 unknowns)."""
+    kind = CLASSES[i % len(CLASSES)]
+    j = i if i < count else (i - count) + (i - count) // len(CLASSES)
+    return kind, 2 + (j // len(CLASSES) if i < count else j) % 2
 
 
 # ---- judging --------------------------------------------------------------------------
@@ -208,8 +216,7 @@ def problem_by_name(name: str, seed: int = 1, count: int = 10000, sizes=(1, 60),
     index = int(name.rsplit("-", 1)[1])
     rng = np.random.default_rng(seed)
     for i in range(index + 1):
-        kind = CLASSES[i % len(CLASSES)]
-        dim = 2 + (i // len(CLASSES)) % 2
+        kind, dim = kind_and_dim(i, count)
         lo, hi = sizes if i < count else (300, 1000)
         p = make_problem(rng, kind, dim, int(rng.integers(lo, hi + 1)), i)
     if p.name != name:
