@@ -22,16 +22,8 @@ using namespace flexcontact;
 
 namespace
 {
-using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
 using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 using RealArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-std::vector<bool> flags(const std::optional<BoolArray>& a)
-{
-  if (!a)
-    return {};
-  return std::vector<bool>(a->data(), a->data() + a->size());
-}
 
 /// @brief Node–node or node–segment pairs with frames from the masters' normals, built in
 /// one call: slave (m), masters (m × j), weights (m × j), normals (m × d), offsets (m or none).
@@ -98,16 +90,8 @@ void flexcontact::bind_condensed(py::module& m)
           [convergence_error](CondensedContact& c, const Vector& up_c,
                               const std::optional<Vector>& e)
           {
-            CondensedStep r;
-            try
-            {
-              py::gil_scoped_release release;
-              r = e ? c.step(up_c, *e) : c.step(up_c);
-            }
-            catch (const ConvergenceError& e)
-            {
-              raise_convergence_error(convergence_error, e);
-            }
+            const CondensedStep r = step_or_raise(
+                convergence_error, [&] { return e ? c.step(up_c, *e) : c.step(up_c); });
             return condensed_step_dict(r, c.dim());
           },
           py::arg("up_c"), py::arg("e") = py::none(),
@@ -125,16 +109,9 @@ void flexcontact::bind_condensed(py::module& m)
           [convergence_error](CondensedContact& c, const Vector& b_c,
                               const std::optional<Vector>& e)
           {
-            CondensedStep r;
-            try
-            {
-              py::gil_scoped_release release;
-              r = c.step_condensed(b_c, e ? *e : Vector::Zero(c.rigid_modes().cols()));
-            }
-            catch (const ConvergenceError& e)
-            {
-              raise_convergence_error(convergence_error, e);
-            }
+            const CondensedStep r = step_or_raise(
+                convergence_error, [&]
+                { return c.step_condensed(b_c, e ? *e : Vector::Zero(c.rigid_modes().cols())); });
             return condensed_step_dict(r, c.dim());
           },
           py::arg("b_c"), py::arg("e") = py::none(),

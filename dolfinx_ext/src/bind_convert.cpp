@@ -63,6 +63,13 @@ py::dict report_dict(const SolveReport& r)
   return d;
 }
 
+std::vector<bool> flags(const std::optional<BoolArray>& a)
+{
+  if (!a)
+    return {};
+  return std::vector<bool>(a->data(), a->data() + a->size());
+}
+
 void raise_convergence_error(py::handle cls, const ConvergenceError& e)
 {
   py::object error = cls(e.what());

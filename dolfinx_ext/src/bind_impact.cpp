@@ -22,8 +22,6 @@ using namespace flexcontact;
 
 namespace
 {
-using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
-
 py::dict step_dict(const ImpactStep& r, int dim)
 {
   py::dict d;
@@ -63,11 +61,8 @@ void flexcontact::bind_impact(py::module& m)
                   double e, double dt, double theta, const std::optional<BoolArray>& held,
                   const SolverOptions& options)
                {
-                 std::vector<bool> flags;
-                 if (held)
-                   flags.assign(held->data(), held->data() + held->size());
                  return ImpactContact(dim, std::move(F), std::move(X), std::move(pairs),
-                                      std::move(mu), e, dt, theta, std::move(flags), options);
+                                      std::move(mu), e, dt, theta, flags(held), options);
                }),
            py::arg("dim"), py::arg("F"), py::arg("X"), py::arg("pairs"), py::arg("mu"),
            py::arg("restitution"), py::arg("dt_s"), py::arg("theta") = 0.5,
@@ -77,16 +72,8 @@ void flexcontact::bind_impact(py::module& m)
           [convergence_error](ImpactContact& c, const Vector& u_c, const Vector& v_c,
                               const Vector& vfree_c)
           {
-            ImpactStep r;
-            try
-            {
-              py::gil_scoped_release release;
-              r = c.step(u_c, v_c, vfree_c);
-            }
-            catch (const ConvergenceError& e)
-            {
-              raise_convergence_error(convergence_error, e);
-            }
+            const ImpactStep r
+                = step_or_raise(convergence_error, [&] { return c.step(u_c, v_c, vfree_c); });
             return step_dict(r, c.dim());
           },
           py::arg("u_c"), py::arg("v_c"), py::arg("vfree_c"),

@@ -125,11 +125,10 @@ std::string report_repr(const SolveReport& r)
     << ", pairs=" << r.states.size() << ")";
   return s.str();
 }
-} // namespace
 
-void flexcontact::bind_kernel(py::module& m)
+/// @brief ConvergenceError, raised with the best report as its attribute `report`.
+void bind_errors(py::module& m)
 {
-  // ---- exceptions ----------------------------------------------------------------------
   static py::exception<ConvergenceError> convergence_error(m, "ConvergenceError",
                                                            PyExc_RuntimeError);
   py::register_exception_translator(
@@ -149,8 +148,11 @@ void flexcontact::bind_kernel(py::module& m)
           PyErr_SetObject(convergence_error.ptr(), inst.ptr());
         }
       });
+}
 
-  // ---- problem.hpp ---------------------------------------------------------------------
+/// @brief problem.hpp: PairState, SolverOptions, SolveReport.
+void bind_problem(py::module& m)
+{
   py::enum_<PairState>(m, "PairState", "Contact state of a pair")
       .value("open", PairState::open)
       .value("stick", PairState::stick)
@@ -211,8 +213,11 @@ void flexcontact::bind_kernel(py::module& m)
       .def_readonly("cycled", &SolveReport::cycled)
       .def_readonly("attempts", &SolveReport::attempts)
       .def("__repr__", &report_repr);
+}
 
-  // ---- pairs.hpp -----------------------------------------------------------------------
+/// @brief pairs.hpp: ContactPair, frames, the gap operator B, x0 and W.
+void bind_pairs(py::module& m)
+{
   py::class_<ContactPair>(m, "ContactPair", "One slave node against a master point")
       .def(py::init<>())
       .def(py::init(
@@ -270,8 +275,11 @@ void flexcontact::bind_kernel(py::module& m)
       },
       py::arg("rows"), py::arg("cols"), py::arg("vals"), py::arg("shape"), py::arg("F"),
       "W = B F* B^T (symmetrised) with B given as COO triplets");
+}
 
-  // ---- residual.hpp --------------------------------------------------------------------
+/// @brief residual.hpp: the cone projection, the natural-map residual and the states.
+void bind_residual(py::module& m)
+{
   m.def(
       "project_on_cone",
       [](Vector r, double mu)
@@ -311,8 +319,11 @@ void flexcontact::bind_kernel(py::module& m)
       },
       py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lam"),
       py::arg("tol") = 1e-8, "Pair states (0 open, 1 stick, 2 slip) read from lambda");
+}
 
-  // ---- solvers.hpp ---------------------------------------------------------------------
+/// @brief solvers.hpp: the chain and each local solver alone.
+void bind_solvers(py::module& m)
+{
   // Every solver takes the same Python arguments (states0 is ignored by those that do not
   // use states), checked once here, and runs without the GIL.
   auto def_solver = [&m](const char* name, auto solver, const char* doc)
@@ -360,9 +371,12 @@ void flexcontact::bind_kernel(py::module& m)
   m.def("default_chain", &default_chain, "Default solver order, most robust first");
   m.def("chain_time_budget_s", &chain_time_budget_s, py::arg("n"),
         "The chain's wall-clock budget (s) for n unknowns when time_budget_s is 0: "
-        "3 + 10 (n/1000)^3");
+        "10 + 10 (n/1000)^3");
+}
 
-  // ---- increment.hpp -------------------------------------------------------------------
+/// @brief increment.hpp: the incremental driver.
+void bind_increment(py::module& m)
+{
   py::class_<IncrementalSolver>(m, "IncrementalSolver",
                                 "Incremental driver: W, mu and the history between increments")
       .def(py::init<int, Matrix, Vector, SolverOptions>(), py::arg("dim"), py::arg("W"),
@@ -389,7 +403,17 @@ void flexcontact::bind_kernel(py::module& m)
       .def("pairs", &IncrementalSolver::pairs)
       .def("dim", &IncrementalSolver::dim)
       .def_property_readonly("W", [](const IncrementalSolver& s) { return s.W(); });
+}
+} // namespace
 
+void flexcontact::bind_kernel(py::module& m)
+{
+  bind_errors(m);
+  bind_problem(m);
+  bind_pairs(m);
+  bind_residual(m);
+  bind_solvers(m);
+  bind_increment(m);
   bind_condensed(m);
   bind_impact(m);
 }

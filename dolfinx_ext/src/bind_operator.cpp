@@ -26,7 +26,6 @@ using namespace flexcontact;
 
 namespace
 {
-using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
 using DofArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 
 /// @brief The kernel object with the PETSc operator it calls, kept alive together.
@@ -58,14 +57,11 @@ void flexcontact::bind_operator(py::module& m)
                  std::vector<PetscInt> d(dofs.data(), dofs.data() + dofs.size());
                  auto F = std::make_shared<FactorFlexibility>(factor, K, std::move(d),
                                                               n_virtual);
-                 std::vector<bool> held;
-                 if (constrained)
-                   held.assign(constrained->data(), constrained->data() + constrained->size());
                  FactorContact c;
                  c.flexibility = F;
                  c.contact = std::make_unique<OperatorContact>(
                      dim, [F](const Vector& r) { return (*F)(r); }, std::move(X),
-                     std::move(pairs), std::move(mu), std::move(held), options);
+                     std::move(pairs), std::move(mu), flags(constrained), options);
                  return c;
                }),
            py::arg("dim"), py::arg("factor"), py::arg("K"), py::arg("dofs"),
@@ -79,16 +75,8 @@ void flexcontact::bind_operator(py::module& m)
           "step",
           [convergence_error](FactorContact& c, const Vector& up_c)
           {
-            CondensedStep r;
-            try
-            {
-              py::gil_scoped_release release;
-              r = c.contact->step(up_c);
-            }
-            catch (const ConvergenceError& e)
-            {
-              raise_convergence_error(convergence_error, e);
-            }
+            const CondensedStep r
+                = step_or_raise(convergence_error, [&] { return c.contact->step(up_c); });
             return condensed_step_dict(r, c.contact->dim());
           },
           py::arg("up_c"),

@@ -51,6 +51,26 @@ py::object factor_object(Flexibility& r, std::span<const std::int64_t> dofs, py:
   return py::cast(r.factor, py::return_value_policy::take_ownership);
 }
 
+/// @brief x = K⁻¹ b by either factor, without the GIL (a solve may wait in MPI collectives).
+template <class Factor>
+void solve_without_gil(Factor& f, Vec b, Vec x)
+{
+  py::gil_scoped_release release;
+  f.solve(b, x);
+}
+
+/// @brief Either factor's condensation of b, computed without the GIL, as a NumPy array.
+template <class Factor>
+py::array_t<double> condense_without_gil(Factor& f, Vec b)
+{
+  std::vector<double> c;
+  {
+    py::gil_scoped_release release;
+    c = f.condense(b);
+  }
+  return py::array_t<double>(static_cast<py::ssize_t>(c.size()), c.data());
+}
+
 void bind_schur_factor(py::module& m)
 {
   py::class_<SchurSolve>(
@@ -70,29 +90,12 @@ void bind_schur_factor(py::module& m)
             return s.mat();
           },
           py::return_value_policy::reference_internal, "The factor as a petsc4py Mat")
-      .def(
-          "solve",
-          [](SchurSolve& s, Vec b, Vec x)
-          {
-            py::gil_scoped_release release;
-            s.solve(b, x);
-          },
-          py::arg("b"), py::arg("x"), "x = K^-1 b (a full solve). Collective.")
-      .def(
-          "condense",
-          [](SchurSolve& s, Vec b)
-          {
-            std::vector<double> c;
-            {
-              py::gil_scoped_release release;
-              c = s.condense(b);
-            }
-            return py::array_t<double>(c.size(), c.data());
-          },
-          py::arg("b"),
-          "MUMPS's condensation of b (forward elimination): the reduced right-hand side "
-          "b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order given to flexibility. "
-          "MUMPS keeps the interior's part for the next expand. Collective.")
+      .def("solve", &solve_without_gil<SchurSolve>, py::arg("b"), py::arg("x"),
+           "x = K^-1 b (a full solve). Collective.")
+      .def("condense", &condense_without_gil<SchurSolve>, py::arg("b"),
+           "MUMPS's condensation of b (forward elimination): the reduced right-hand side "
+           "b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order given to flexibility. "
+           "MUMPS keeps the interior's part for the next expand. Collective.")
       .def(
           "expand",
           [](SchurSolve& s, py::array_t<double, py::array::c_style | py::array::forcecast> u_c,
@@ -147,28 +150,11 @@ void bind_distributed_schur(py::module& m)
       R"(K factored by MUMPS on several ranks with a Schur complement on the contact DOFs
 (returned by flexibility(K, dofs, "schur") there). Every method is collective.)")
       .def_property_readonly("has_condense", [](const DistributedSchur&) { return true; })
-      .def(
-          "solve",
-          [](DistributedSchur& f, Vec b, Vec x)
-          {
-            py::gil_scoped_release release;
-            f.solve(b, x);
-          },
-          py::arg("b"), py::arg("x"), "x = K^-1 b (b, x laid out as K's rows).")
-      .def(
-          "condense",
-          [](DistributedSchur& f, Vec b)
-          {
-            std::vector<double> r;
-            {
-              py::gil_scoped_release release;
-              r = f.condense(b);
-            }
-            return py::array_t<double>(static_cast<py::ssize_t>(r.size()), r.data());
-          },
-          py::arg("b"),
-          "Reduced right-hand side b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order "
-          "given to flexibility, on rank 0 (empty elsewhere).")
+      .def("solve", &solve_without_gil<DistributedSchur>, py::arg("b"), py::arg("x"),
+           "x = K^-1 b (b, x laid out as K's rows).")
+      .def("condense", &condense_without_gil<DistributedSchur>, py::arg("b"),
+           "Reduced right-hand side b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order "
+           "given to flexibility, on rank 0 (empty elsewhere).")
       .def(
           "expand",
           [](DistributedSchur& f, const py::object& u_c, Vec x)
@@ -184,18 +170,37 @@ void bind_distributed_schur(py::module& m)
       .def("destroy", &DistributedSchur::release,
            "Free the MUMPS instance now (otherwise when the object goes).");
 }
-} // namespace
 
-void flexcontact::bind_petsc(py::module& m)
+/// @brief flexibility()'s `info` dict without the factor's entries (condense,
+/// condense_fallback), which go with the factor object.
+py::dict flexibility_info(const Flexibility& r)
 {
-  bind_schur_factor(m);
-  py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError",
-                                                 PyExc_RuntimeError);
-  py::register_exception<MumpsError>(m, "MumpsError", PyExc_RuntimeError);
-  py::register_exception<PetscError>(m, "PetscError", PyExc_RuntimeError);
+  py::dict info;
+  info["method"] = r.method;
+  info["n_contact_dofs"] = r.n_contact_dofs;
+  info["null_pivots"] = r.null_pivots;
+  info["factorizations"] = r.factorizations;
+  info["factorization_retries"] = r.factorization_retries;
+  info["factorization_s"] = r.factorization_s;
+  info["schur_s"] = r.schur_s;
+  info["inverse_s"] = r.inverse_s;
+  info["ordering"] = r.ordering;
+  info["mumps_ordering"] = r.mumps_ordering;
+  info["ordering_fallback"] = r.ordering_fallback;
+  info["ordering_s"] = r.ordering_s;
+  info["analysis_s"] = r.analysis_s;
+  info["factor_entries"] = r.factor_entries;
+  info["factor_flops"] = r.factor_flops;
+  info["factor_memory_mb"] = r.factor_memory_mb;
+  info["n_blocks"] = r.n_blocks;
+  info["block_sizes"] = r.block_sizes;
+  info["blocks_s"] = r.blocks_s;
+  return info;
+}
 
-  bind_distributed_schur(m);
-
+/// @brief flexibility(): F* and the factor of K from one factorization.
+void bind_flexibility(py::module& m)
+{
   m.def(
       "flexibility",
       [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
@@ -207,26 +212,7 @@ void flexcontact::bind_petsc(py::module& m)
           py::gil_scoped_release release;
           r = flexibility(K, dofs, method, ordering, per_body);
         }
-        py::dict info;
-        info["method"] = r.method;
-        info["n_contact_dofs"] = r.n_contact_dofs;
-        info["null_pivots"] = r.null_pivots;
-        info["factorizations"] = r.factorizations;
-        info["factorization_retries"] = r.factorization_retries;
-        info["factorization_s"] = r.factorization_s;
-        info["schur_s"] = r.schur_s;
-        info["inverse_s"] = r.inverse_s;
-        info["ordering"] = r.ordering;
-        info["mumps_ordering"] = r.mumps_ordering;
-        info["ordering_fallback"] = r.ordering_fallback;
-        info["ordering_s"] = r.ordering_s;
-        info["analysis_s"] = r.analysis_s;
-        info["factor_entries"] = r.factor_entries;
-        info["factor_flops"] = r.factor_flops;
-        info["factor_memory_mb"] = r.factor_memory_mb;
-        info["n_blocks"] = r.n_blocks;
-        info["block_sizes"] = r.block_sizes;
-        info["blocks_s"] = r.blocks_s;
+        py::dict info = flexibility_info(r);
         py::object factor;
         if (r.distributed)
         {
@@ -276,7 +262,11 @@ blocks_s (finding the blocks), condense (factor is a SchurFactor), condense_fall
 serial Schur factor could not be split: this PETSc's MUMPS structure; empty otherwise).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
+}
 
+/// @brief factor_analysis(): what a factorization would cost, from MUMPS's analysis.
+void bind_factor_analysis(py::module& m)
+{
   m.def(
       "factor_analysis",
       [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
@@ -304,4 +294,18 @@ solver failures, ValueError on bad arguments. Collective.)");
 flexibility) and a Schur complement on contact_dofs (none if empty) would cost. Returns a
 dict: ordering, mumps_ordering (INFOG(7)), n_contact_dofs, estimated_entries (INFOG(20)),
 estimated_flops (RINFOG(1)), estimated_memory_mb (INFOG(17)), analysis_s, ordering_s.)");
+}
+} // namespace
+
+void flexcontact::bind_petsc(py::module& m)
+{
+  bind_schur_factor(m);
+  py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError",
+                                                 PyExc_RuntimeError);
+  py::register_exception<MumpsError>(m, "MumpsError", PyExc_RuntimeError);
+  py::register_exception<PetscError>(m, "PetscError", PyExc_RuntimeError);
+
+  bind_distributed_schur(m);
+  bind_flexibility(m);
+  bind_factor_analysis(m);
 }

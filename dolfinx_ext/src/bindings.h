@@ -11,6 +11,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <optional>
 #include <vector>
 
 namespace flexcontact
@@ -52,4 +53,26 @@ pybind11::dict report_dict(const SolveReport& r);
 /// @brief Raises `e` in Python as the module's ConvergenceError `cls`, its report attached as
 /// a plain dict (attribute `report`), like a step's result.
 [[noreturn]] void raise_convergence_error(pybind11::handle cls, const ConvergenceError& e);
+
+/// @brief Runs one step of a contact object, `step()`, without the GIL (a step takes long and
+/// may wait in MPI collectives), raising a ConvergenceError as the module's `cls`.
+template <class Step>
+auto step_or_raise(pybind11::handle cls, const Step& step) -> decltype(step())
+{
+  try
+  {
+    pybind11::gil_scoped_release release;
+    return step();
+  }
+  catch (const ConvergenceError& e)
+  {
+    raise_convergence_error(cls, e);
+  }
+}
+
+/// @brief Flags from Python (NumPy booleans, anything NumPy casts to them).
+using BoolArray = pybind11::array_t<bool, pybind11::array::c_style | pybind11::array::forcecast>;
+
+/// @brief The contact objects' `constrained` flags: None for none held.
+std::vector<bool> flags(const std::optional<BoolArray>& a);
 } // namespace flexcontact

@@ -6,7 +6,9 @@
 /// INFOG, the same everywhere) must not leave the other ranks waiting in a collective call.
 
 #include <mpi.h>
+#include <numeric>
 #include <string>
+#include <vector>
 
 namespace flexcontact
 {
@@ -25,6 +27,24 @@ inline void throw_collective_if(MPI_Comm comm, bool fail_on_root, const std::str
   what.resize(len);
   MPI_Bcast(what.data(), len, MPI_CHAR, 0, comm);
   make(what);
+}
+
+/// @brief All ranks' `local` concatenated in rank order on rank 0 (empty elsewhere); `type`
+/// is T's MPI datatype (MPI_INT64_T, MPI_DOUBLE).
+template <class T>
+std::vector<T> gather_on_root(MPI_Comm comm, const std::vector<T>& local, MPI_Datatype type)
+{
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int count = static_cast<int>(local.size());
+  std::vector<int> counts(size), offsets(size + 1, 0);
+  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  std::partial_sum(counts.begin(), counts.end(), offsets.begin() + 1);
+  std::vector<T> all(rank == 0 ? offsets.back() : 0);
+  MPI_Gatherv(local.data(), count, type, all.data(), counts.data(), offsets.data(), type, 0,
+              comm);
+  return all;
 }
 
 /// @brief The MumpsError for MUMPS's global status INFOG(1) < 0 after `phase`.

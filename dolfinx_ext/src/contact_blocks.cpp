@@ -1,6 +1,7 @@
 // Copyright flexcontact developers. MIT licence.
 
 #include "contact_blocks.h"
+#include "collective.h"
 #include "flexibility.h"
 #include "petsc_error.h"
 
@@ -156,15 +157,7 @@ std::vector<int> flexcontact::contact_blocks(Mat K, const std::vector<PetscInt>&
     send.push_back(comp(i));
     send.push_back(static_cast<std::int64_t>(ghost_comp[g]));
   }
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  int count = static_cast<int>(send.size());
-  std::vector<int> counts(size), displs(size + 1, 0);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  std::partial_sum(counts.begin(), counts.end(), displs.begin() + 1);
-  std::vector<std::int64_t> edges(rank == 0 ? displs.back() : 0);
-  MPI_Gatherv(send.data(), count, MPI_INT64_T, edges.data(), counts.data(), displs.data(),
-              MPI_INT64_T, 0, comm);
+  const std::vector<std::int64_t> edges = gather_on_root(comm, send, MPI_INT64_T);
 
   const std::vector<double> dof_comp
       = values_at(err, label, rank == 0 ? dofs : std::vector<PetscInt>());

@@ -74,38 +74,37 @@ int check_null_pivots(PetscErrorScope& err, Mat F)
   return static_cast<int>(n);
 }
 
-/// @brief The ordering MUMPS used and the size and cost of its factor (global INFOG/RINFOG).
-void factor_statistics(PetscErrorScope& err, Mat F, Flexibility& out)
+/// @brief Where MUMPS reports the size and cost of a factor (global INFOG/RINFOG indices):
+/// entries (INFOG < 0 counts millions), flops, and memory in MB.
+struct FactorSizeFields
 {
-  PetscInt infog7 = 0, infog29 = 0, infog22 = 0;
-  PetscReal flops = 0;
-  err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
-  err.check(MatMumpsGetInfog(F, 29, &infog29), "MatMumpsGetInfog(29)");
-  err.check(MatMumpsGetInfog(F, 22, &infog22), "MatMumpsGetInfog(22)");
-  err.check(MatMumpsGetRinfog(F, 3, &flops), "MatMumpsGetRinfog(3)");
-  out.mumps_ordering = ordering_name(static_cast<int>(infog7));
-  // INFOG(29) < 0 counts millions of entries
-  out.factor_entries = infog29 >= 0 ? static_cast<std::int64_t>(infog29)
-                                    : -static_cast<std::int64_t>(infog29) * 1000000;
-  out.factor_flops = flops;
-  out.factor_memory_mb = static_cast<int>(infog22);
-}
+  int entries, flops, memory_mb;
+};
+/// After the factorization: INFOG(29), RINFOG(3), INFOG(22).
+constexpr FactorSizeFields factorized{29, 3, 22};
+/// What the analysis expects of the factorization: INFOG(20), RINFOG(1), INFOG(17).
+constexpr FactorSizeFields estimated{20, 1, 17};
 
-/// @brief What MUMPS's analysis expects of the factorization (INFOG(20), RINFOG(1),
-/// INFOG(17)), in the fields factor_statistics() fills after it.
-void analysis_estimates(PetscErrorScope& err, Mat F, Flexibility& out)
+/// @brief The ordering MUMPS used (INFOG(7)) and the size and cost of its factor, read
+/// from `fields`.
+void factor_size(PetscErrorScope& err, Mat F, FactorSizeFields fields, Flexibility& out)
 {
-  PetscInt infog7 = 0, infog20 = 0, infog17 = 0;
+  auto infog = [&](int i)
+  {
+    PetscInt v = 0;
+    err.check(MatMumpsGetInfog(F, i, &v), ("MatMumpsGetInfog(" + std::to_string(i) + ")").c_str());
+    return v;
+  };
+  const PetscInt infog7 = infog(7), entries = infog(fields.entries);
+  const PetscInt memory_mb = infog(fields.memory_mb);
   PetscReal flops = 0;
-  err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
-  err.check(MatMumpsGetInfog(F, 20, &infog20), "MatMumpsGetInfog(20)");
-  err.check(MatMumpsGetInfog(F, 17, &infog17), "MatMumpsGetInfog(17)");
-  err.check(MatMumpsGetRinfog(F, 1, &flops), "MatMumpsGetRinfog(1)");
+  err.check(MatMumpsGetRinfog(F, fields.flops, &flops),
+            ("MatMumpsGetRinfog(" + std::to_string(fields.flops) + ")").c_str());
   out.mumps_ordering = ordering_name(static_cast<int>(infog7));
-  out.factor_entries = infog20 >= 0 ? static_cast<std::int64_t>(infog20)
-                                    : -static_cast<std::int64_t>(infog20) * 1000000;
+  out.factor_entries = entries >= 0 ? static_cast<std::int64_t>(entries)
+                                    : -static_cast<std::int64_t>(entries) * 1000000;
   out.factor_flops = flops;
-  out.factor_memory_mb = static_cast<int>(infog17);
+  out.factor_memory_mb = static_cast<int>(memory_mb);
 }
 
 /// @brief MUMPS Cholesky of K with the fill-reducing `ordering` (ordering.h; serial unless
@@ -187,7 +186,7 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
     }
     if (analysis_only)
     {
-      analysis_estimates(err, F.m, out);
+      factor_size(err, F.m, estimated, out);
       return F.release();
     }
     err.check(MatMumpsSetIcntl(F.m, 24, 1), "MatMumpsSetIcntl(24)");
@@ -203,7 +202,7 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
     }
     check_mumps(err, F.m, "factorization");
     out.null_pivots = check_null_pivots(err, F.m);
-    factor_statistics(err, F.m, out);
+    factor_size(err, F.m, factorized, out);
     return F.release();
   }
 }
@@ -334,15 +333,7 @@ Eigen::MatrixXd multi_rhs_solve(PetscErrorScope& err, MPI_Comm comm, int rank, M
   }
   err.check(MatDenseRestoreArrayRead(X.m, &x), "MatDenseRestoreArrayRead");
 
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  int count = static_cast<int>(send.size());
-  std::vector<int> counts(size), offsets(size + 1, 0);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  std::partial_sum(counts.begin(), counts.end(), offsets.begin() + 1);
-  std::vector<double> recv(rank == 0 ? offsets.back() : 0);
-  MPI_Gatherv(send.data(), count, MPI_DOUBLE, recv.data(), counts.data(), offsets.data(),
-              MPI_DOUBLE, 0, comm);
+  const std::vector<double> recv = gather_on_root(comm, send, MPI_DOUBLE);
 
   Eigen::MatrixXd Fs;
   if (rank == 0)

@@ -1,6 +1,7 @@
 // Copyright flexcontact developers. MIT licence.
 
 #include "ordering.h"
+#include "collective.h"
 #include "petsc_error.h"
 
 #include <dmumps_c.h>
@@ -137,23 +138,6 @@ std::vector<std::int64_t> local_node_edges(Mat K, PetscInt bs, PetscInt rstart, 
   return edges;
 }
 
-/// @brief All ranks' `local` concatenated in rank order on rank 0 (empty elsewhere).
-std::vector<std::int64_t> gather_on_root(MPI_Comm comm, const std::vector<std::int64_t>& local)
-{
-  int rank = 0, size = 1;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  int count = static_cast<int>(local.size());
-  std::vector<int> counts(size), offsets(size + 1, 0);
-  MPI_Gather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  for (int r = 0; r < size; ++r)
-    offsets[r + 1] = offsets[r] + counts[r];
-  std::vector<std::int64_t> all(rank == 0 ? offsets.back() : 0);
-  MPI_Gatherv(local.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
-              MPI_INT64_T, 0, comm);
-  return all;
-}
-
 /// @brief METIS's symmetric graph (both directions, no repeats) of n nodes from edges
 /// (v, w) given in either or both directions.
 void graph_from_edges(std::int64_t n, const std::vector<std::int64_t>& edges,
@@ -252,7 +236,7 @@ std::vector<int> flexcontact::metis_pivot_order_gathered(Mat K, std::span<const 
   if (!aligned)
     bs = 1;
   const std::vector<std::int64_t> edges = local_node_edges(K, bs, rstart, rend);
-  const std::vector<std::int64_t> all = gather_on_root(comm, edges);
+  const std::vector<std::int64_t> all = gather_on_root(comm, edges, MPI_INT64_T);
   if (rank != 0)
     return {};
   std::vector<idx_t> xadj, adj;

@@ -46,6 +46,16 @@ DMUMPS_STRUC_C* checked_mumps(Mat F, PetscInt N, std::span<const PetscInt> dofs)
     throw MumpsLayoutError(kLayout);
   return id;
 }
+
+/// @brief Throws unless v has K's N rows; `what` names the call and the vector ("condense: b").
+void check_rows(PetscErrorScope& err, Vec v, PetscInt N, const char* what)
+{
+  PetscInt n = 0;
+  err.check(VecGetSize(v, &n), "VecGetSize");
+  if (n != N)
+    throw std::invalid_argument(std::string(what) + " has " + std::to_string(n)
+                                + " entries, K has " + std::to_string(N) + " rows");
+}
 } // namespace
 
 SchurSolve::SchurSolve(Mat F, std::span<const PetscInt> dofs)
@@ -124,11 +134,7 @@ void SchurSolve::run_phase(int phase)
 std::vector<double> SchurSolve::condense(Vec b)
 {
   PetscErrorScope err;
-  PetscInt n = 0;
-  err.check(VecGetSize(b, &n), "VecGetSize");
-  if (n != N_)
-    throw std::invalid_argument("condense: b has " + std::to_string(n) + " entries, K has "
-                                + std::to_string(N_) + " rows");
+  check_rows(err, b, N_, "condense: b");
   condensed_ = false;
   rhs_.resize(static_cast<std::size_t>(N_));
   redrhs_.assign(static_cast<std::size_t>(n_c_), 0.0);
@@ -150,11 +156,7 @@ void SchurSolve::expand(std::span<const double> u_c, Vec x)
     throw std::invalid_argument("expand: u_c has " + std::to_string(u_c.size())
                                 + " entries, expected n_c = " + std::to_string(n_c_));
   PetscErrorScope err;
-  PetscInt n = 0;
-  err.check(VecGetSize(x, &n), "VecGetSize");
-  if (n != N_)
-    throw std::invalid_argument("expand: x has " + std::to_string(n) + " entries, K has "
-                                + std::to_string(N_) + " rows");
+  check_rows(err, x, N_, "expand: x");
   std::copy(u_c.begin(), u_c.end(), redrhs_.begin());
   condensed_ = false;
   run_phase(2);

@@ -4,14 +4,15 @@
 /// @brief The condensed contact problem: B, x0, W = B F* Bᵀ from pairs and F*, and one
 /// increment from u_p on the contact DOFs to λ, gap, states and contact forces.
 
+#include "carry_over.hpp"
 #include "constrained.hpp"
+#include "contact_checks.hpp"
 #include "flexcontact/condensed.hpp"
+#include "message_numbers.hpp"
 #include "python_float.hpp"
 #include "step_summary.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -20,60 +21,19 @@ namespace flexcontact
 namespace
 {
 const std::string who = "flexcontact: CondensedContact: ";
-
-std::string size_of(const Matrix& A)
-{
-  return std::to_string(A.rows()) + "x" + std::to_string(A.cols());
-}
-
-int checked_dim(int dim)
-{
-  if (dim != 2 && dim != 3)
-    throw std::invalid_argument(who + "dim is " + std::to_string(dim) + "; it must be 2 or 3");
-  return dim;
-}
-
-/// @brief Throws unless F* is n_c × n_c and finite.
-void check_flexibility(const Matrix& F, Eigen::Index n_c)
-{
-  if (F.rows() != n_c || F.cols() != n_c)
-    throw std::invalid_argument(who + "F* is " + size_of(F) + ", expected "
-                                + std::to_string(n_c) + "x" + std::to_string(n_c)
-                                + " (contact nodes × dim)");
-  if (!F.allFinite())
-    throw std::invalid_argument(who + "F* is not finite");
-}
-
-void check_mu(const Vector& mu, std::size_t m)
-{
-  if (static_cast<std::size_t>(mu.size()) != m)
-    throw std::invalid_argument(who + "mu has " + std::to_string(mu.size())
-                                + " entries but there are " + std::to_string(m) + " pairs");
-}
-
-std::string exp3(double v)
-{
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3e", v);
-  return buf;
-}
 } // namespace
 
 CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
                                    std::vector<ContactPair> pairs, Vector mu,
                                    std::vector<bool> constrained, SolverOptions options)
-    : dim_(checked_dim(dim)), F_(std::move(Fstar)), X_(std::move(X)), pairs_(std::move(pairs)),
-      mu_(std::move(mu)), constrained_(std::move(constrained)), options_(std::move(options)),
-      solver_(dim_, Matrix(), Vector(), options_)
+    : dim_(detail::checked_dim(dim, who)), F_(std::move(Fstar)), X_(std::move(X)),
+      pairs_(std::move(pairs)), mu_(std::move(mu)), constrained_(std::move(constrained)),
+      options_(std::move(options)), solver_(dim_, Matrix(), Vector(), options_)
 {
-  if (X_.cols() != dim_)
-    throw std::invalid_argument(who + "X is " + size_of(X_) + "; it must have dim = "
-                                + std::to_string(dim_) + " columns");
-  if (!X_.allFinite())
-    throw std::invalid_argument(who + "X (contact node coordinates) is not finite");
+  detail::check_coordinates(X_, dim_, who);
   const Eigen::Index n_c = X_.rows() * dim_;
-  check_flexibility(F_, n_c);
-  check_mu(mu_, pairs_.size());
+  detail::check_flexibility(F_, n_c, "F*", who);
+  detail::check_mu_count(mu_, pairs_.size(), who);
   zero_constrained(F_, constrained_, who);
   // gap_operator and initial_gap check the pairs against the node count and dimension.
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
@@ -96,7 +56,7 @@ void CondensedContact::set_rigid_modes(Matrix Rc)
 
 void CondensedContact::set_flexibility(Matrix Fstar)
 {
-  check_flexibility(Fstar, F_.rows());
+  detail::check_flexibility(Fstar, F_.rows(), "F*", who);
   zero_constrained(Fstar, constrained_, who);
   solver_.set_delassus(delassus(B_, Fstar));
   F_ = std::move(Fstar);
@@ -104,14 +64,18 @@ void CondensedContact::set_flexibility(Matrix Fstar)
 
 void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
 {
-  check_mu(mu, pairs.size());
+  detail::check_mu_count(mu, pairs.size(), who);
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
   IncrementalSolver solver(dim_, delassus(B, F_), mu, options_);
   solver.set_initial_gap(u_c_.size() ? Vector(B * u_c_ + x0) : x0);
   if (!solver_.states().empty())
-    solver.set_warm_start(carried_force(pairs), carried_states(pairs));
+  {
+    const std::vector<int> previous = detail::previous_pair_of(pairs_, pairs, X_.rows());
+    solver.set_warm_start(detail::carried_force(pairs_, solver_.force(), pairs, previous, dim_),
+                          detail::carried_states(solver_.states(), previous));
+  }
   if (R_.cols())
     solver.set_border(B * R_);
   B_ = std::move(B);
@@ -119,41 +83,6 @@ void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   solver_ = std::move(solver);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
-}
-
-std::vector<int> CondensedContact::previous_pair_of(const std::vector<ContactPair>& pairs) const
-{
-  std::vector<int> of_slave(static_cast<std::size_t>(X_.rows()), -1);
-  for (std::size_t k = 0; k < pairs_.size(); ++k)
-    of_slave[static_cast<std::size_t>(pairs_[k].slave)] = static_cast<int>(k);
-  std::vector<int> previous(pairs.size(), -1);
-  for (std::size_t k = 0; k < pairs.size(); ++k)
-    previous[k] = of_slave[static_cast<std::size_t>(pairs[k].slave)];
-  return previous;
-}
-
-Vector CondensedContact::carried_force(const std::vector<ContactPair>& pairs) const
-{
-  // The slave node's force in global axes, T_oldᵀ λ_old, seen in the new frame.
-  const std::vector<int> previous = previous_pair_of(pairs);
-  const Vector& old = solver_.force();
-  Vector lambda = Vector::Zero(static_cast<Eigen::Index>(pairs.size()) * dim_);
-  for (std::size_t k = 0; k < pairs.size(); ++k)
-    if (const int j = previous[k]; j >= 0)
-      lambda.segment(static_cast<Eigen::Index>(k) * dim_, dim_)
-          = pairs[k].frame * (pairs_[j].frame.transpose() * old.segment(j * dim_, dim_));
-  return lambda;
-}
-
-std::vector<PairState> CondensedContact::carried_states(
-    const std::vector<ContactPair>& pairs) const
-{
-  const std::vector<int> previous = previous_pair_of(pairs);
-  std::vector<PairState> states(pairs.size(), PairState::open);
-  for (std::size_t k = 0; k < pairs.size(); ++k)
-    if (previous[k] >= 0)
-      states[k] = solver_.states()[static_cast<std::size_t>(previous[k])];
-  return states;
 }
 
 std::string CondensedContact::held_and_penetrating(const Vector& q) const
@@ -184,7 +113,7 @@ std::string CondensedContact::held_and_penetrating(const Vector& q) const
   return std::to_string(count)
          + " contact pair(s) are held by Dirichlet conditions on both sides and pushed into "
            "each other, so no contact force can separate them; e.g. the slave node at "
-         + at + " penetrates by " + exp3(-q[first * dim_])
+         + at + " penetrates by " + detail::exp3(-q[first * dim_])
          + " m. Release one side or change the prescribed displacements";
 }
 
@@ -214,11 +143,7 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
     throw std::invalid_argument(who + "step: e has " + std::to_string(e.size())
                                 + " entries, expected one per rigid mode ("
                                 + std::to_string(R_.cols()) + ")");
-  if (up_c.size() != F_.rows())
-    throw std::invalid_argument(who + "step: up_c has " + std::to_string(up_c.size())
-                                + " entries, expected n_c = " + std::to_string(F_.rows()));
-  if (!up_c.allFinite())
-    throw std::invalid_argument(who + "step: up_c is not finite");
+  detail::check_contact_values(who + "step: ", "up_c", up_c, F_.rows());
   q_ = B_ * up_c + x0_;
   const std::string held = held_and_penetrating(q_);
   if (!held.empty())

@@ -7,20 +7,17 @@
 #include "flexcontact/increment.hpp"
 #include "flexcontact/solvers.hpp"
 
+#include "contact_checks.hpp"
+#include "message_numbers.hpp"
+
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 namespace flexcontact
 {
 namespace
 {
-std::string num(double v)
-{
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+using detail::num;
 
 /// @brief Throws naming the first non-finite entry of W and its pair.
 void check_finite(const std::string& who, const Matrix& W, int dim)
@@ -32,15 +29,28 @@ void check_finite(const std::string& who, const Matrix& W, int dim)
                                     + ") is " + num(W(i, j)) + " (pair "
                                     + std::to_string(i / dim) + "); W must be finite");
 }
+
+/// @brief Throws unless the pair-by-pair vector `name` has n entries, naming its first
+/// non-finite entry and that entry's pair.
+void check_pair_vector(const std::string& who, const char* name,
+                       const Eigen::Ref<const Vector>& v, Eigen::Index n, int dim)
+{
+  if (v.size() != n)
+    throw std::invalid_argument(who + name + " has size " + std::to_string(v.size())
+                                + ", expected " + std::to_string(n));
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i]))
+      throw std::invalid_argument(who + name + "[" + std::to_string(i) + "] (pair "
+                                  + std::to_string(i / dim) + ") is " + num(v[i]) + "; "
+                                  + name + " must be finite");
+}
 } // namespace
 
 IncrementalSolver::IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions options)
     : dim_(dim), W_(std::move(W)), mu_(std::move(mu)), options_(std::move(options))
 {
   const std::string who = "flexcontact: IncrementalSolver: ";
-  if (dim_ != 2 && dim_ != 3)
-    throw std::invalid_argument(who + "dimension is " + std::to_string(dim_)
-                                + "; it must be 2 or 3");
+  detail::checked_dim(dim_, who);
   const Eigen::Index n = mu_.size() * dim_;
   if (W_.rows() != W_.cols())
     throw std::invalid_argument(who + "W is " + std::to_string(W_.rows()) + "x"
@@ -49,18 +59,9 @@ IncrementalSolver::IncrementalSolver(int dim, Matrix W, Vector mu, SolverOptions
     throw std::invalid_argument(who + "W has " + std::to_string(W_.rows()) + " rows but "
                                 + std::to_string(mu_.size()) + " pairs in " + std::to_string(dim_)
                                 + "D need " + std::to_string(n));
-  for (Eigen::Index k = 0; k < mu_.size(); ++k)
-    if (!std::isfinite(mu_[k]) || mu_[k] < 0.0)
-      throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
-                                  + " is " + num(mu_[k]) + "; it must be finite and >= 0");
+  detail::check_friction(mu_, who);
   check_finite(who, W_, dim_);
-  if (options_.max_iterations < 1)
-    throw std::invalid_argument(who + "max_iterations is "
-                                + std::to_string(options_.max_iterations)
-                                + "; it must be at least 1");
-  if (!(options_.tolerance > 0.0) || !std::isfinite(options_.tolerance))
-    throw std::invalid_argument(who + "tolerance is " + num(options_.tolerance)
-                                + "; it must be finite and > 0");
+  detail::check_iteration_options(options_, who);
   // Unknown solver names are reported now rather than at the first increment.
   for (const auto& name : options_.chain)
   {
@@ -90,14 +91,8 @@ void IncrementalSolver::set_border(Matrix G)
 
 void IncrementalSolver::set_initial_gap(const Eigen::Ref<const Vector>& x0)
 {
-  const std::string who = "flexcontact: IncrementalSolver::set_initial_gap: ";
-  if (x0.size() != x_.size())
-    throw std::invalid_argument(who + "x0 has size " + std::to_string(x0.size())
-                                + ", expected " + std::to_string(x_.size()));
-  for (Eigen::Index i = 0; i < x0.size(); ++i)
-    if (!std::isfinite(x0[i]))
-      throw std::invalid_argument(who + "x0[" + std::to_string(i) + "] (pair "
-                                  + std::to_string(i / dim_) + ") is " + num(x0[i]));
+  check_pair_vector("flexcontact: IncrementalSolver::set_initial_gap: ", "x0", x0, x_.size(),
+                    dim_);
   x_ = x0;
 }
 
@@ -146,14 +141,7 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
                                            const Eigen::Ref<const Vector>& e)
 {
   const std::string who = "flexcontact: IncrementalSolver::step: ";
-  if (q_total.size() != W_.rows())
-    throw std::invalid_argument(who + "q has size " + std::to_string(q_total.size())
-                                + ", expected " + std::to_string(W_.rows()));
-  for (Eigen::Index i = 0; i < q_total.size(); ++i)
-    if (!std::isfinite(q_total[i]))
-      throw std::invalid_argument(who + "q[" + std::to_string(i) + "] (pair "
-                                  + std::to_string(i / dim_) + ") is " + num(q_total[i])
-                                  + "; q must be finite");
+  check_pair_vector(who, "q", q_total, W_.rows(), dim_);
 
   if (e.size() != G_.cols())
     throw std::invalid_argument(who + "e has " + std::to_string(e.size())

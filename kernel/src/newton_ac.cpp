@@ -7,17 +7,14 @@
 #include "flexcontact/solvers.hpp"
 
 #include "ac_pair.hpp"
+#include "newton_step.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <string>
 #include <vector>
-
 
 namespace flexcontact
 {
@@ -40,198 +37,6 @@ void spectral_rho(const ProblemView& p, const Vector& fallback, Vector& rn, Vect
     rn[k] = (std::isfinite(w) && w > 1e-12 / fallback[k]) ? 1.0 / w : fallback[k];
     rt[k] = rn[k];
   }
-}
-/// @brief Φ(λ) for all pairs from λ and u = Wλ + q; optionally the blocks ∂P/∂z (d×d each).
-void ac_all(const ProblemView& p, const Vector& rho, const Vector& rho_t, const Vector& lam,
-            const Vector& u, Vector& phi, std::vector<double>* dP)
-{
-  const int d = p.dim;
-  for (int k = 0; k < p.pairs(); ++k)
-    detail::ac_pair(lam.data() + k * d, u.data() + k * d, p.mu[k], rho[k], rho_t[k], d,
-                    phi.data() + k * d, dP ? dP->data() + k * d * d : nullptr);
-}
-
-/// @brief Solve A x = b, pivoted LU first. A singular A (semi-definite W, fully constrained
-/// pairs) gets the minimum-norm least-squares step instead: it moves nothing along the null
-/// space, where an LU or a small regularisation would send λ off to huge values that the
-/// relative residual then mistakes for convergence. Beyond a size where a rank-revealing
-/// factorisation is too slow, a Tikhonov-regularised LU is the fallback. Returns false if
-/// no finite solution was found.
-bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
-{
-  const double bn = b.norm();
-  {
-    Eigen::PartialPivLU<Matrix> lu(A);
-    x = lu.solve(b);
-    if (x.allFinite() && (A * x - b).norm() <= 1e-8 * std::max(bn, 1e-300))
-      return true;
-  }
-  if (A.rows() <= 1500)
-  {
-    Eigen::CompleteOrthogonalDecomposition<Matrix> cod(A);
-    cod.setThreshold(1e-12);
-    x = cod.compute(A).solve(b);
-    return x.allFinite();
-  }
-  const double scale = std::max(A.cwiseAbs().rowwise().sum().maxCoeff(), 1e-300);
-  Matrix R = A;
-  R.diagonal().array() += 1e-8 * scale;
-  x = Eigen::PartialPivLU<Matrix>(R).solve(b);
-  return x.allFinite();
-}
-
-/// @brief Φ and the blocks ∂P/∂z at (λ, u); returns the merit ½‖Φ‖².
-double merit(const ProblemView& p, const Vector& rho, const Vector& rho_t, const Vector& lam,
-             const Vector& u, Vector& phi, std::vector<double>& dP)
-{
-  ac_all(p, rho, rho_t, lam, u, phi, &dP);
-  return 0.5 * phi.squaredNorm();
-}
-
-/// @brief The pairs whose block ∂P/∂z is not zero; the others (open) decouple from the
-/// Newton system.
-void closed_pairs(const std::vector<double>& dP, int m, int d, std::vector<int>& closed)
-{
-  closed.clear();
-  for (int k = 0; k < m; ++k)
-  {
-    const double* D = dP.data() + k * d * d;
-    bool nz = false;
-    for (int i = 0; i < d * d; ++i)
-      nz = nz || D[i] != 0.0;
-    if (nz)
-      closed.push_back(k);
-  }
-}
-
-/// @brief Newton direction dl from the generalised Jacobian, J Δ = −Φ with
-/// J = I − D (I − ρW) = (I − D) + D ρ W, D = blockdiag(∂P/∂z). Pairs with D_k = 0 (open)
-/// have identity rows: Δ_k = −Φ_k; only the closed block is factorised, which keeps the
-/// dense LU to the size of the contact zone. Returns false if that block has no solution.
-bool newton_direction(const ProblemView& p, const Vector& rho, const Vector& rho_t,
-                      const Vector& phi, const std::vector<double>& dP,
-                      const std::vector<int>& closed, Vector& dl)
-{
-  const int d = p.dim;
-  dl = -phi;
-  const int nc = static_cast<int>(closed.size());
-  if (nc == 0)
-    return true;
-  // Rows of the closed pairs: (I−D)_kk Δ_k + D_k ρ_k Σ_j W_kj Δ_j = −Φ_k, with Δ_open known.
-  // Since Δ = −Φ on open pairs, W_kj Δ_j for open j moves to the right-hand side; the
-  // full product WΔ₀ (Δ₀ zero on closed pairs) gives it at once.
-  Vector d0 = dl;
-  for (int k : closed)
-    d0.segment(k * d, d).setZero();
-  const Vector Wd0 = p.W * d0;
-  Matrix A(nc * d, nc * d);
-  Vector b(nc * d);
-  for (int a = 0; a < nc; ++a)
-  {
-    const int k = closed[a];
-    Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
-        D(dP.data() + k * d * d, d, d);
-    Matrix Dr = D;
-    Dr.col(0) *= rho[k];
-    Dr.rightCols(d - 1) *= rho_t[k];
-    for (int c = 0; c < nc; ++c)
-      A.block(a * d, c * d, d, d).noalias() = Dr * p.W.block(k * d, closed[c] * d, d, d);
-    A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - D;
-    b.segment(a * d, d) = -phi.segment(k * d, d) - Dr * Wd0.segment(k * d, d);
-  }
-  Vector x;
-  if (!linear_solve(A, b, x))
-    return false;
-  for (int a = 0; a < nc; ++a)
-    dl.segment(closed[a] * d, d) = x.segment(a * d, d);
-  return true;
-}
-
-/// @brief Non-monotone reference of the line search: the largest merit of the last few
-/// accepted iterates lets the iteration pass the shallow ridges the kinks of Φ create
-/// (Grippo–Lampariello–Lucidi).
-class MeritHistory
-{
-public:
-  explicit MeritHistory(double f) : f_{f} {}
-
-  /// @brief Forgets the earlier iterates (after a restart).
-  void reset(double f) { f_.assign(1, f); }
-
-  void push(double f)
-  {
-    f_.push_back(f);
-    if (static_cast<int>(f_.size()) > memory)
-      f_.erase(f_.begin());
-  }
-
-  double reference() const { return *std::max_element(f_.begin(), f_.end()); }
-
-private:
-  static constexpr int memory = 5;
-  std::vector<double> f_;
-};
-
-/// @brief The line search's trial iterate: λ + α Δ, u + α WΔ, its Φ, and WΔ.
-struct Trial
-{
-  Vector lam, u, phi, Wdl;
-};
-
-/// @brief The merit ½‖Φ‖² at λ + α Δ (filling t); +inf if not finite.
-double trial_merit(const ProblemView& p, const Vector& rho, const Vector& rho_t,
-                   const Vector& lam, const Vector& u, const Vector& dl, double alpha, Trial& t)
-{
-  t.lam = lam + alpha * dl;
-  t.u = u + alpha * t.Wdl;
-  ac_all(p, rho, rho_t, t.lam, t.u, t.phi, nullptr);
-  const double ft = 0.5 * t.phi.squaredNorm();
-  return std::isfinite(ft) ? ft : std::numeric_limits<double>::infinity();
-}
-
-/// @brief Line search on ½‖Φ‖², Armijo with the non-monotone reference of history. If the
-/// Newton direction dl gives no decrease, the fixed-point direction −Φ (a projected step)
-/// replaces it (not with full_step, where the caller then takes the full Newton step).
-/// Returns true with the accepted iterate in t.
-bool line_search(const ProblemView& p, const Vector& rho, const Vector& rho_t,
-                 const Vector& lam, const Vector& u, const Vector& phi, double f,
-                 const MeritHistory& history, bool full_step, Vector& dl, Trial& t)
-{
-  constexpr double sigma = 1e-4;
-  const double fref = full_step ? f : history.reference();
-  for (int attempt = 0; attempt < (full_step ? 1 : 2); ++attempt)
-  {
-    if (attempt == 1)
-      dl = -phi;
-    t.Wdl.noalias() = p.W * dl;
-    double alpha = 1.0;
-    for (int ls = 0; ls < 40; ++ls, alpha *= 0.5)
-      if (trial_merit(p, rho, rho_t, lam, u, dl, alpha, t) <= fref - 2.0 * sigma * alpha * f)
-        return true;
-  }
-  return false;
-}
-
-/// @brief Goldstein–Price search along the Newton direction (the merit's slope there is
-/// −2f): α is accepted when the mean slope (f(α) − f)/α lies between 0.99 and 0.01 times
-/// the initial one; too steep raises the lower bound, too shallow lowers the upper, and
-/// α bisects the bracket. Returns true with the accepted iterate in t.
-bool goldstein_price(const ProblemView& p, const Vector& rho, const Vector& rho_t,
-                     const Vector& lam, const Vector& u, double f, const Vector& dl, Trial& t)
-{
-  const double slope0 = -2.0 * f;
-  t.Wdl.noalias() = p.W * dl;
-  double lo = 0.0, hi = 1e10, alpha = 1.0;
-  for (int ls = 0; ls < 100; ++ls)
-  {
-    const double slope = (trial_merit(p, rho, rho_t, lam, u, dl, alpha, t) - f) / alpha;
-    const bool not_too_steep = slope >= 0.99 * slope0;
-    if (not_too_steep && slope <= 0.01 * slope0)
-      return true;
-    (not_too_steep ? hi : lo) = alpha;
-    alpha = 0.5 * (lo + hi);
-  }
-  return false;
 }
 
 /// @brief A few Gauss–Seidel sweeps with exact pair solves, stopping early once the
@@ -264,6 +69,212 @@ void finish_report(const ProblemView& p, const Vector& lam, int it, int sweeps_u
                          + " in " + std::to_string(it) + " iterations, residual "
                          + std::to_string(rep.residual) + why);
 }
+
+/// @brief ρ of the Alart–Curnier map Φ (normal and tangential), and of the natural-map
+/// residual, which the Gauss–Seidel sweeps share.
+struct NewtonRho
+{
+  Vector residual, normal, tangential;
+};
+
+NewtonRho newton_rho(const ProblemView& p, const detail::NewtonSettings& settings)
+{
+  NewtonRho r;
+  r.residual = pair_rho(p);
+  r.normal = r.residual;
+  r.tangential = detail::tangential_rho(p, r.normal);
+  if (settings.block_rho)
+    spectral_rho(p, r.residual, r.normal, r.tangential);
+  return r;
+}
+
+/// @brief The residual's history: the best iterate met (full steps make the iteration
+/// non-monotone) and the last iteration that halved the residual, which decides when
+/// Newton has stalled.
+class Progress
+{
+public:
+  Progress(double res, const Vector& lam) : gain_ref_{res}, best_{res}, best_lam_(lam) {}
+
+  /// @brief After an accepted step of iteration it.
+  void stepped(int it, double res, const Vector& lam)
+  {
+    if (res < 0.5 * gain_ref_)
+    {
+      gain_ref_ = res;
+      last_gain_ = it;
+    }
+    keep_best(res, lam);
+  }
+
+  /// @brief After Gauss–Seidel restarted iteration it: the stall count starts again.
+  void restarted(int it, double res, const Vector& lam)
+  {
+    last_gain_ = it;
+    gain_ref_ = std::min(gain_ref_, res);
+    keep_best(res, lam);
+  }
+
+  bool stalled(int it) const { return it - last_gain_ >= stall; }
+
+  double best() const { return best_; }
+  const Vector& best_lambda() const { return best_lam_; }
+
+private:
+  void keep_best(double res, const Vector& lam)
+  {
+    if (res < best_)
+    {
+      best_ = res;
+      best_lam_ = lam;
+    }
+  }
+
+  /// Iterations without halving the residual before Newton is declared stalled.
+  static constexpr int stall = 8;
+  int last_gain_ = 0;
+  double gain_ref_, best_;
+  Vector best_lam_;
+};
+
+/// @brief One run of the Newton of detail::newton_ac(): the iterate (λ, u = Wλ + q), Φ and
+/// its blocks ∂P/∂z there, and the globalisation's state.
+class NewtonRun
+{
+public:
+  NewtonRun(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+            const SolverOptions& opt, const detail::NewtonSettings& settings)
+      : p_(p), opt_(opt), settings_(settings), rho_(newton_rho(p, settings)),
+        lam_(lambda0.size() ? Vector(lambda0) : Vector::Zero(p.q.size())),
+        u_(p.W * lam_ + p.q), phi_(p.q.size()), dl_(p.q.size()),
+        trial_{Vector(p.q.size()), Vector(p.q.size()), Vector(p.q.size()), Vector(p.q.size())},
+        dP_(static_cast<std::size_t>(p.pairs()) * p.dim * p.dim),
+        f_(detail::merit(p, rho_.normal, rho_.tangential, lam_, u_, phi_, dP_)),
+        res_(natural_map_residual(p, lam_, u_, rho_.residual)), history_(f_),
+        progress_(res_, lam_)
+  {
+    closed_.reserve(p.pairs());
+  }
+
+  SolveReport run();
+
+private:
+  bool globalised_step();
+  bool gauss_seidel_restart();
+  void take_trial();
+
+  const ProblemView& p_;
+  const SolverOptions& opt_;
+  const detail::NewtonSettings& settings_;
+  const NewtonRho rho_;
+  Vector lam_, u_, phi_, dl_;
+  detail::Trial trial_;
+  std::vector<double> dP_;
+  std::vector<int> closed_;
+  double f_;   ///< merit ½‖Φ‖² at λ
+  double res_; ///< natural-map residual at λ
+  detail::MeritHistory history_;
+  Progress progress_;
+  int it_ = 0, sweeps_used_ = 0, full_steps_ = 0;
+};
+
+SolveReport NewtonRun::run()
+{
+  const long maxit
+      = static_cast<long>(opt_.max_iterations) * std::max(settings_.iteration_factor, 1);
+  std::string why;
+  const detail::Deadline deadline(opt_.time_budget_s);
+  while (res_ > opt_.tolerance && it_ < maxit)
+  {
+    if (deadline.passed())
+    {
+      why = ", time budget spent";
+      break;
+    }
+    ++it_;
+    detail::closed_pairs(dP_, p_.pairs(), p_.dim, closed_);
+    if (!detail::newton_direction(p_, rho_.normal, rho_.tangential, phi_, dP_, closed_, dl_))
+    {
+      why = ", linear system not solvable";
+      break;
+    }
+    // Even after an accepted step a stalled Newton restarts from λ (not from the trial).
+    const bool accepted = globalised_step();
+    if (!accepted || (!settings_.full_step && progress_.stalled(it_)))
+    {
+      if (!gauss_seidel_restart())
+      {
+        why = ", non-finite iterate";
+        break;
+      }
+      continue;
+    }
+    take_trial();
+  }
+  if (full_steps_ > 0)
+    why += ", full steps " + std::to_string(full_steps_);
+  // Full steps make the iteration non-monotone: report the best iterate met.
+  if (settings_.full_step && !(res_ <= opt_.tolerance) && progress_.best() < res_)
+    lam_ = progress_.best_lambda();
+
+  SolveReport rep;
+  rep.solver = "newton_ac";
+  finish_report(p_, lam_, it_, sweeps_used_, why, opt_.tolerance, rep);
+  return rep;
+}
+
+/// @brief The line search along the Newton direction, or with full_step Siconos' rule where
+/// it finds no decrease. Returns true with the next iterate in trial_.
+bool NewtonRun::globalised_step()
+{
+  const Vector& rn = rho_.normal;
+  const Vector& rt = rho_.tangential;
+  const bool found = settings_.full_step && settings_.goldstein_price
+                         ? detail::goldstein_price(p_, rn, rt, lam_, u_, f_, dl_, trial_)
+                         : detail::line_search(p_, rn, rt, lam_, u_, phi_, f_, history_,
+                                               settings_.full_step, dl_, trial_);
+  if (found || !settings_.full_step)
+    return found;
+  // Siconos' rule: no decrease along the Newton direction, take the full step anyway.
+  ++full_steps_;
+  trial_.lam = lam_ + dl_;
+  trial_.u.noalias() = p_.W * trial_.lam + p_.q;
+  return trial_.lam.allFinite();
+}
+
+/// @brief Stalled: the sweeps move λ to where Newton converges fast again. Returns false if
+/// they leave a non-finite λ.
+bool NewtonRun::gauss_seidel_restart()
+{
+  ++sweeps_used_;
+  gauss_seidel_sweeps(p_, rho_.residual, opt_.tolerance, lam_, u_, res_);
+  if (!lam_.allFinite())
+    return false;
+  f_ = detail::merit(p_, rho_.normal, rho_.tangential, lam_, u_, phi_, dP_);
+  history_.reset(f_);
+  progress_.restarted(it_, res_, lam_);
+  if (opt_.verbose)
+    std::fprintf(stderr, "newton_ac it %d: Gauss-Seidel sweeps, residual %.3e\n", it_, res_);
+  return true;
+}
+
+/// @brief Moves to the accepted trial iterate and evaluates Φ, the merit and the residual.
+void NewtonRun::take_trial()
+{
+  lam_.swap(trial_.lam);
+  // Recompute u now and then: the running update accumulates rounding on long runs.
+  if (it_ % 20 == 0)
+    u_.noalias() = p_.W * lam_ + p_.q;
+  else
+    u_.swap(trial_.u);
+  f_ = detail::merit(p_, rho_.normal, rho_.tangential, lam_, u_, phi_, dP_);
+  history_.push(f_);
+  res_ = natural_map_residual(p_, lam_, u_, rho_.residual);
+  progress_.stepped(it_, res_, lam_);
+  if (opt_.verbose)
+    std::fprintf(stderr, "newton_ac it %d: closed %d, merit %.3e, residual %.3e\n", it_,
+                 static_cast<int>(closed_.size()), f_, res_);
+}
 } // namespace
 
 SolveReport solve_newton_ac(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
@@ -276,116 +287,6 @@ SolveReport detail::newton_ac(const ProblemView& p, const Eigen::Ref<const Vecto
                               const SolverOptions& opt, const NewtonSettings& settings)
 {
   detail::check_problem(p, lambda0, "solve_newton_ac");
-  const int d = p.dim;
-  const int m = p.pairs();
-  const int n = m * d;
-  const Vector rho_res = pair_rho(p);
-  Vector rho = rho_res;
-  Vector rho_t = detail::tangential_rho(p, rho);
-  if (settings.block_rho)
-    spectral_rho(p, rho_res, rho, rho_t);
-  const long maxit = static_cast<long>(opt.max_iterations) * std::max(settings.iteration_factor, 1);
-
-  SolveReport rep;
-  rep.solver = "newton_ac";
-  Vector lam = lambda0.size() ? Vector(lambda0) : Vector::Zero(n);
-  Vector u = p.W * lam + p.q;
-  Vector phi(n), dl(n);
-  Trial trial{Vector(n), Vector(n), Vector(n), Vector(n)};
-  std::vector<double> dP(static_cast<std::size_t>(m) * d * d);
-  std::vector<int> closed;
-  closed.reserve(m);
-
-  double f = merit(p, rho, rho_t, lam, u, phi, dP);
-  double res = natural_map_residual(p, lam, u, rho_res);
-  int it = 0;
-  std::string why;
-  int last_gain = 0, sweeps_used = 0, full_steps = 0;
-  double gain_ref = res, best = res;
-  Vector best_lam = lam;
-  // Iterations without halving the residual before Newton is declared stalled.
-  constexpr int stall = 8;
-  MeritHistory history(f);
-  const detail::Deadline deadline(opt.time_budget_s);
-  while (res > opt.tolerance && it < maxit)
-  {
-    if (deadline.passed())
-    {
-      why = ", time budget spent";
-      break;
-    }
-    ++it;
-    closed_pairs(dP, m, d, closed);
-    if (!newton_direction(p, rho, rho_t, phi, dP, closed, dl))
-    {
-      why = ", linear system not solvable";
-      break;
-    }
-    bool accepted = settings.full_step && settings.goldstein_price
-                        ? goldstein_price(p, rho, rho_t, lam, u, f, dl, trial)
-                        : line_search(p, rho, rho_t, lam, u, phi, f, history,
-                                      settings.full_step, dl, trial);
-    if (!accepted && settings.full_step)
-    {
-      // Siconos' rule: no decrease along the Newton direction, take the full step anyway.
-      ++full_steps;
-      trial.lam = lam + dl;
-      trial.u.noalias() = p.W * trial.lam + p.q;
-      accepted = trial.lam.allFinite();
-    }
-    if (!accepted || (!settings.full_step && it - last_gain >= stall))
-    {
-      // Stalled: the sweeps move λ to where Newton converges fast again.
-      ++sweeps_used;
-      gauss_seidel_sweeps(p, rho_res, opt.tolerance, lam, u, res);
-      if (!lam.allFinite())
-      {
-        why = ", non-finite iterate";
-        break;
-      }
-      f = merit(p, rho, rho_t, lam, u, phi, dP);
-      history.reset(f);
-      last_gain = it;
-      gain_ref = std::min(gain_ref, res);
-      if (res < best)
-      {
-        best = res;
-        best_lam = lam;
-      }
-      if (opt.verbose)
-        std::fprintf(stderr, "newton_ac it %d: Gauss-Seidel sweeps, residual %.3e\n", it, res);
-      continue;
-    }
-    lam.swap(trial.lam);
-    // Recompute u now and then: the running update accumulates rounding on long runs.
-    if (it % 20 == 0)
-      u.noalias() = p.W * lam + p.q;
-    else
-      u.swap(trial.u);
-    f = merit(p, rho, rho_t, lam, u, phi, dP);
-    history.push(f);
-    res = natural_map_residual(p, lam, u, rho_res);
-    if (res < 0.5 * gain_ref)
-    {
-      gain_ref = res;
-      last_gain = it;
-    }
-    if (res < best)
-    {
-      best = res;
-      best_lam = lam;
-    }
-    if (opt.verbose)
-      std::fprintf(stderr, "newton_ac it %d: closed %d, merit %.3e, residual %.3e\n", it,
-                   static_cast<int>(closed.size()), f, res);
-  }
-  if (full_steps > 0)
-    why += ", full steps " + std::to_string(full_steps);
-  // Full steps make the iteration non-monotone: report the best iterate met.
-  if (settings.full_step && !(res <= opt.tolerance) && best < res)
-    lam = best_lam;
-
-  finish_report(p, lam, it, sweeps_used, why, opt.tolerance, rep);
-  return rep;
+  return NewtonRun(p, lambda0, opt, settings).run();
 }
 } // namespace flexcontact

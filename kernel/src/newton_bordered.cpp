@@ -8,6 +8,8 @@
 #include "flexcontact/solvers.hpp"
 
 #include "ac_pair.hpp"
+#include "message_numbers.hpp"
+#include "newton_step.hpp"
 
 #include <Eigen/QR>
 #include <Eigen/SVD>
@@ -71,27 +73,14 @@ double residual(const Bordered& b, const Iterate& s)
 std::vector<int> closed_pairs(const Iterate& s, int m, int d)
 {
   std::vector<int> closed;
-  for (int k = 0; k < m; ++k)
-  {
-    bool nz = false;
-    for (int i = 0; i < d * d; ++i)
-      nz = nz || s.dP[static_cast<std::size_t>(k * d * d + i)] != 0.0;
-    if (nz)
-      closed.push_back(k);
-  }
+  detail::closed_pairs(s.dP, m, d, closed);
   return closed;
 }
 
-/// @brief D_k with its normal column times ρ_n and tangential columns times ρ_t.
+/// @brief D_k ρ of pair k at the iterate s (newton_step.hpp).
 Matrix scaled_d(const Bordered& b, const Iterate& s, int k)
 {
-  const int d = b.p.dim;
-  Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> D(
-      s.dP.data() + k * d * d, d, d);
-  Matrix Dr = D;
-  Dr.col(0) *= b.rho[k];
-  Dr.rightCols(d - 1) *= b.rho_t[k];
-  return Dr;
+  return detail::scaled_dp(s.dP, k, b.p.dim, b.rho[k], b.rho_t[k]);
 }
 
 /// @brief Minimum-norm solution of A x = b (complete orthogonal decomposition).
@@ -124,9 +113,7 @@ bool newton_direction(const Bordered& b, const Iterate& s, Vector& dl, Vector& d
     const Matrix Dr = scaled_d(b, s, kk);
     for (int c = 0; c < nc; ++c)
       A.block(a * d, c * d, d, d).noalias() = Dr * b.p.W.block(kk * d, closed[c] * d, d, d);
-    Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> D(
-        s.dP.data() + kk * d * d, d, d);
-    A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - Matrix(D);
+    A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - detail::dp_block(s.dP, kk, d);
     A.block(a * d, nc * d, d, k).noalias() = Dr * b.G.middleRows(kk * d, d) / b.rbar;
     A.block(nc * d, a * d, k, d) = b.G.middleRows(kk * d, d).transpose();
     rhs.segment(a * d, d) = -s.phi.segment(kk * d, d) - Dr * Wd0.segment(kk * d, d);
@@ -254,7 +241,7 @@ SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const M
   double res = residual(b, s);
   int it = 0;
   std::string why;
-  std::vector<double> history{s.f};
+  detail::MeritHistory history(s.f);
   Iterate t;
   while (res > opt.tolerance && it < opt.max_iterations)
   {
@@ -265,16 +252,13 @@ SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const M
       why = ", linear system not solvable";
       break;
     }
-    const double fref = *std::max_element(history.begin(), history.end());
-    if (!line_search(b, s, dl, da, fref, t))
+    if (!line_search(b, s, dl, da, history.reference(), t))
     {
       why = ", line search failed (no static equilibrium near this iterate?)";
       break;
     }
     std::swap(s, t);
-    history.push_back(s.f);
-    if (history.size() > 5)
-      history.erase(history.begin());
+    history.push(s.f);
     res = residual(b, s);
     if (opt.verbose)
       std::fprintf(stderr, "newton_bordered it %d: merit %.3e, residual %.3e\n", it, s.f, res);
@@ -290,11 +274,10 @@ SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const M
   rep.converged = res <= opt.tolerance;
   const ProblemView v{p.dim, p.W, s.qe, p.mu};
   rep.states = classify_states(v, rep.lambda, rep.u);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3e", res);
   rep.attempts.push_back("newton_ac (bordered" + std::string(cold ? ", all-stick start" : "")
                          + "): " + (rep.converged ? "converged" : "not converged") + " in "
-                         + std::to_string(it) + " iterations, residual " + buf + why);
+                         + std::to_string(it) + " iterations, residual " + detail::exp3(res)
+                         + why);
   return rep;
 }
 

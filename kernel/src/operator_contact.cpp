@@ -5,10 +5,12 @@
 /// applied and never formed.
 
 #include "flexcontact/operator_contact.hpp"
+#include "carry_over.hpp"
+#include "constrained.hpp"
+#include "contact_checks.hpp"
+#include "message_numbers.hpp"
 #include "step_summary.hpp"
 
-#include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -17,34 +19,19 @@ namespace flexcontact
 namespace
 {
 const std::string who = "flexcontact: OperatorContact: ";
-
-std::string sci(double v)
-{
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3e", v);
-  return buf;
-}
 } // namespace
 
 OperatorContact::OperatorContact(int dim, LinearOperator flexibility, Matrix X,
                                  std::vector<ContactPair> pairs, Vector mu,
                                  std::vector<bool> constrained, SolverOptions options)
-    : dim_(dim), F_(std::move(flexibility)), X_(std::move(X)), constrained_(std::move(constrained)),
-      options_(std::move(options))
+    : dim_(detail::checked_dim(dim, who)), F_(std::move(flexibility)), X_(std::move(X)),
+      constrained_(std::move(constrained)), options_(std::move(options))
 {
-  if (dim_ != 2 && dim_ != 3)
-    throw std::invalid_argument(who + "dim is " + std::to_string(dim_) + "; it must be 2 or 3");
   if (!F_)
     throw std::invalid_argument(who + "the flexibility operator is empty");
-  if (X_.cols() != dim_ || !X_.allFinite())
-    throw std::invalid_argument(who + "X must be finite with dim = " + std::to_string(dim_)
-                                + " columns");
-  if (!constrained_.empty() && static_cast<int>(constrained_.size()) != contact_dofs())
-    throw std::invalid_argument(who + "constrained has " + std::to_string(constrained_.size())
-                                + " entries, expected 0 or n_c = "
-                                + std::to_string(contact_dofs()));
-  if (!(options_.tolerance > 0.0) || options_.max_iterations < 1)
-    throw std::invalid_argument(who + "tolerance must be > 0 and max_iterations ≥ 1");
+  detail::check_coordinates(X_, dim_, who);
+  check_constrained(constrained_, contact_dofs(), who);
+  detail::check_iteration_options(options_, who);
   set_pairs(std::move(pairs), std::move(mu));
 }
 
@@ -70,38 +57,17 @@ Vector OperatorContact::apply_W(const Vector& x) const
   return B_ * flex(B_.transpose() * x);
 }
 
-std::vector<int> OperatorContact::previous_pair_of(const std::vector<ContactPair>& pairs) const
-{
-  std::vector<int> of_slave(static_cast<std::size_t>(X_.rows()), -1);
-  for (std::size_t k = 0; k < pairs_.size(); ++k)
-    of_slave[static_cast<std::size_t>(pairs_[k].slave)] = static_cast<int>(k);
-  std::vector<int> previous(pairs.size(), -1);
-  for (std::size_t k = 0; k < pairs.size(); ++k)
-    previous[k] = of_slave[static_cast<std::size_t>(pairs[k].slave)];
-  return previous;
-}
-
 void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
 {
-  if (static_cast<std::size_t>(mu.size()) != pairs.size())
-    throw std::invalid_argument(who + "mu has " + std::to_string(mu.size())
-                                + " entries but there are " + std::to_string(pairs.size())
-                                + " pairs");
+  detail::check_mu_count(mu, pairs.size(), who);
+  detail::check_friction(mu, who);
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
-  const Eigen::Index n = static_cast<Eigen::Index>(pairs.size()) * dim_;
   // Slip of the next increment is measured from the new pairs' gap where the bodies are.
   Vector x = up_c_.size() ? Vector(B * (up_c_ + flex(reaction_)) + x0) : x0;
-  Vector lambda = Vector::Zero(n);
-  std::vector<PairState> states(pairs.size(), PairState::open);
-  const std::vector<int> previous = previous_pair_of(pairs);
-  for (std::size_t k = 0; k < pairs.size(); ++k)
-    if (const int j = previous[k]; j >= 0 && lambda_.size())
-    {
-      lambda.segment(static_cast<Eigen::Index>(k) * dim_, dim_)
-          = pairs[k].frame * (pairs_[j].frame.transpose() * lambda_.segment(j * dim_, dim_));
-      states[k] = states_[static_cast<std::size_t>(j)];
-    }
+  const std::vector<int> previous = detail::previous_pair_of(pairs_, pairs, X_.rows());
+  Vector lambda = detail::carried_force(pairs_, lambda_, pairs, previous, dim_);
+  std::vector<PairState> states = detail::carried_states(states_, previous);
   B_ = std::move(B);
   x0_ = std::move(x0);
   x_ = std::move(x);
@@ -109,19 +75,13 @@ void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   states_ = std::move(states);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
-  if (mu_.size() && (mu_.minCoeff() < 0.0 || !mu_.allFinite()))
-    throw std::invalid_argument(who + "mu must be finite and ≥ 0");
   scales_ = operator_scales([this](const Vector& v) { return apply_W(v); }, dim_,
                             static_cast<int>(pairs_.size()));
 }
 
 CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
 {
-  if (up_c.size() != contact_dofs())
-    throw std::invalid_argument(who + "step: up_c has " + std::to_string(up_c.size())
-                                + " entries, expected n_c = " + std::to_string(contact_dofs()));
-  if (!up_c.allFinite())
-    throw std::invalid_argument(who + "step: up_c is not finite");
+  detail::check_contact_values(who + "step: ", "up_c", up_c, contact_dofs());
   const Vector q_total = B_ * up_c + x0_;
   CondensedStep r;
   // The slip of this increment is x_t − x_t,prev: remove the previous tangential gap.
@@ -136,7 +96,8 @@ CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
   r.report.attempts.back() += ", " + std::to_string(applications_ - before) + " F* products";
   if (!r.report.converged)
     throw ConvergenceError("flexcontact: increment did not converge; best residual "
-                               + sci(r.report.residual) + " (tolerance " + sci(options_.tolerance)
+                               + detail::exp3(r.report.residual) + " (tolerance "
+                               + detail::exp3(options_.tolerance)
                                + ") from operator (contact_operator='factor') after "
                                + std::to_string(r.report.iterations) + " iterations",
                            r.report);

@@ -8,6 +8,7 @@
 #include "flexcontact/solvers.hpp"
 
 #include "ac_pair.hpp"
+#include "message_numbers.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -57,10 +58,8 @@ void check_chain(const std::vector<std::string>& chain)
 /// @brief One line of SolveReport::attempts.
 std::string attempt_line(const SolveReport& r)
 {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3e", r.residual);
   std::string line = r.solver + ": " + std::to_string(r.iterations) + " iterations, residual "
-                     + buf;
+                     + detail::exp3(r.residual);
   if (r.state_changes > 0)
     line += ", " + std::to_string(r.state_changes) + " state changes";
   line += r.converged ? ", converged" : (r.cycled ? ", cycled" : ", not converged");
@@ -100,6 +99,7 @@ void zero_undetermined_friction(const ProblemView& p, SolveReport& r)
   r.residual = natural_map_residual(p, r.lambda);
   r.states = classify_states(p, r.lambda, r.u);
 }
+
 /// @brief Newton's step budget from the caller's start, as a multiple of max_iterations.
 /// On ill-conditioned random problems (condition 1e10) Newton needs hundreds of damped steps
 /// (Siconos' NSN_AC, given 1000, used 9–911 on those the chain lost): with 100 it solved
@@ -143,17 +143,189 @@ SolveReport run_solver(const std::string& name, const ProblemView& p, const Vect
   r.solver = name;
   return r;
 }
-/// @brief Keeps r as the best answer if it is; logs the attempt when verbose.
-void keep_best(SolveReport&& r, const SolverOptions& opt, SolveReport& best, bool& have_best,
-               const std::vector<std::string>& attempts)
+
+/// @brief One run of the chain: the best answer so far, the attempts' lines, and the time
+/// budget that the attempts share.
+class ChainRun
 {
-  if (opt.verbose)
-    std::cerr << "solve: " << attempts.back() << "\n";
-  if (!have_best || r.residual < best.residual || (r.converged && !best.converged))
+public:
+  ChainRun(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
+           const std::vector<PairState>& states0, const SolverOptions& opt)
+      : p_(p), lambda0_(lambda0), states0_(states0), opt_(opt),
+        budget_s_(opt.time_budget_s > 0.0 ? opt.time_budget_s : chain_time_budget_s(p.q.size())),
+        deadline_(budget_s_)
   {
-    best = std::move(r);
-    have_best = true;
   }
+
+  SolveReport run(const std::vector<std::string>& chain);
+
+private:
+  bool solved() const { return have_best_ && best_.converged; }
+  SolverOptions left() const;
+  bool out_of_time();
+  void projection_warm_start();
+  void from_two_starts(const std::string& name);
+  void newton_variants_from_zero();
+  void newton_polish(const std::vector<std::string>& chain);
+  void keep_best(SolveReport&& r, const std::string& how);
+  void report_the_start(const std::string& solver);
+
+  const ProblemView& p_;
+  const Eigen::Ref<const Vector>& lambda0_;
+  const std::vector<PairState>& states0_;
+  const SolverOptions& opt_;
+  const double budget_s_;
+  const detail::Deadline deadline_;
+  std::vector<std::string> attempts_;
+  SolveReport best_;
+  bool have_best_ = false;
+  bool budget_noted_ = false;
+};
+
+SolveReport ChainRun::run(const std::vector<std::string>& chain)
+{
+  // Below this many unknowns a Newton step (dense LU, ~n³/3) costs less than the 50 warm
+  // sweeps (~50 n²) it would save: on random problems of up to 180 unknowns Newton from
+  // zero took 0.17 ms (median) against 0.67 ms for the chain with sweeps first.
+  constexpr int warm_start_unknowns = 300;
+  if (opt_.chain.empty() and p_.q.size() >= warm_start_unknowns)
+    projection_warm_start();
+  for (const auto& name : chain)
+  {
+    if (solved())
+      break;
+    from_two_starts(name);
+    if (name == "newton_ac")
+      newton_variants_from_zero();
+  }
+  newton_polish(chain);
+  if (!have_best_)
+    report_the_start(chain.front());
+  if (best_.lambda.size() == p_.q.size() && best_.lambda.allFinite())
+  {
+    const double before = best_.residual;
+    zero_undetermined_friction(p_, best_);
+    // Zeroing can only remove a spurious friction component; it must not spoil an answer.
+    if (best_.converged && !(best_.residual <= std::max(opt_.tolerance, before)))
+      best_.converged = false;
+  }
+  best_.attempts = std::move(attempts_);
+  return std::move(best_);
+}
+
+/// @brief The options of the next attempt: what is left of the chain's budget.
+SolverOptions ChainRun::left() const
+{
+  SolverOptions o = opt_;
+  o.time_budget_s = std::max(deadline_.left_s(), 1e-9);
+  return o;
+}
+
+/// @brief True once the budget is spent; the first time, says so in `attempts`.
+bool ChainRun::out_of_time()
+{
+  if (!deadline_.passed())
+    return false;
+  if (!budget_noted_)
+  {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "time budget of %.3g s spent: no further attempts",
+                  budget_s_);
+    attempts_.emplace_back(buf);
+    budget_noted_ = true;
+  }
+  return true;
+}
+
+/// @brief Default chain on a large problem: a few projection sweeps first. They are cheap
+/// (O((m·d)²) each) and find the open/stick/slip pattern of most pairs, from where Newton
+/// converges in one or two steps: on 2367 unknowns of a sliding block, 50 sweeps + 2 Newton
+/// steps took 0.85 s against 6.6 s for Newton from zero (22 steps of a dense LU).
+void ChainRun::projection_warm_start()
+{
+  SolverOptions warm = left();
+  warm.max_iterations = 1; // the projection solver runs 50 × max_iterations sweeps
+  best_ = solve_projection(p_, lambda0_, warm);
+  best_.solver = "projection";
+  attempts_.push_back(attempt_line(best_) + " (warm start)");
+  if (opt_.verbose)
+    std::cerr << "solve: " << attempts_.back() << "\n";
+  have_best_ = best_.lambda.allFinite() && std::isfinite(best_.residual);
+  if (!have_best_)
+    best_ = SolveReport{};
+}
+
+/// @brief Two starts per solver: the best answer so far (a near-miss of one solver is often
+/// a good start for the next) and the caller's own (λ0, states0), for when it is not. On
+/// random ill-conditioned problems Newton after the projection sweeps stalled at 1e-5 where
+/// Newton from zero converged; the active set from a failed Newton iterate can switch
+/// states thousands of times where from zero it needs a few iterations. So Newton and the
+/// projection start warm, the active set cold, each with the other start as its second try.
+void ChainRun::from_two_starts(const std::string& name)
+{
+  const bool warm_first = name != "active_set";
+  const bool had_best = have_best_;
+  for (int attempt = 0; attempt < 2 && !solved(); ++attempt)
+  {
+    if (attempt == 1 && !had_best)
+      break; // both starts would be the caller's
+    if (out_of_time())
+      break;
+    const bool warm = had_best && (attempt == 0) == warm_first;
+    SolveReport r = run_solver(name, p_, warm ? best_.lambda : Vector(lambda0_),
+                               warm ? best_.states : states0_, left(), !warm);
+    keep_best(std::move(r), warm ? " (from the best so far)" : " (from the given start)");
+  }
+}
+
+/// @brief The projection can end a little short of an answer (1e-6) from where Newton
+/// converges in two steps, though every Newton before it failed from its own starts: on
+/// ill_conditioned-3d-m49-7335 of the campaign (condition 1e10) the projection reached
+/// 9.7e-7 and Newton from there 3.7e-14. So an answer Newton did not itself end on gets one
+/// last Newton from it.
+void ChainRun::newton_polish(const std::vector<std::string>& chain)
+{
+  if (!have_best_ || best_.converged || best_.solver == "newton_ac"
+      || std::find(chain.begin(), chain.end(), "newton_ac") == chain.end() || out_of_time())
+    return;
+  SolveReport r = run_solver("newton_ac", p_, best_.lambda, best_.states, left(), false);
+  keep_best(std::move(r), " (from the best so far, last)");
+}
+
+void ChainRun::newton_variants_from_zero()
+{
+  for (const auto& variant : newton_variants)
+  {
+    if (solved() || out_of_time())
+      break;
+    SolveReport r = detail::newton_ac(p_, Vector::Zero(p_.q.size()), left(), variant.settings);
+    r.solver = "newton_ac";
+    keep_best(std::move(r), variant.label);
+  }
+}
+
+/// @brief Records r's attempt line (how: its start) and keeps r as the best answer if it is.
+void ChainRun::keep_best(SolveReport&& r, const std::string& how)
+{
+  attempts_.push_back(attempt_line(r) + how);
+  if (opt_.verbose)
+    std::cerr << "solve: " << attempts_.back() << "\n";
+  if (!have_best_ || r.residual < best_.residual || (r.converged && !best_.converged))
+  {
+    best_ = std::move(r);
+    have_best_ = true;
+  }
+}
+
+/// @brief The budget ran out before any attempt: the caller's start as it is.
+void ChainRun::report_the_start(const std::string& solver)
+{
+  best_.solver = solver;
+  best_.lambda = lambda0_.size() ? Vector(lambda0_) : Vector::Zero(p_.q.size());
+  best_.u = p_.W * best_.lambda + p_.q;
+  best_.residual = natural_map_residual(p_, best_.lambda);
+  best_.converged = best_.residual <= opt_.tolerance;
+  best_.states = classify_states(p_, best_.lambda, best_.u);
 }
 } // namespace
 
@@ -167,125 +339,6 @@ SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                                 + std::to_string(opt.time_budget_s)
                                 + "; it must be 0 (automatic) or a positive number of seconds");
 
-  std::vector<std::string> attempts;
-  SolveReport best;
-  bool have_best = false;
-  const double budget_s = opt.time_budget_s > 0.0 ? opt.time_budget_s
-                                                  : chain_time_budget_s(p.q.size());
-  const detail::Deadline deadline(budget_s);
-  // Each attempt gets what is left of the chain's budget.
-  auto left = [&]
-  {
-    SolverOptions o = opt;
-    o.time_budget_s = std::max(deadline.left_s(), 1e-9);
-    return o;
-  };
-  auto in_chain = [&](const char* name)
-  { return std::find(chain.begin(), chain.end(), name) != chain.end(); };
-  bool budget_noted = false;
-  auto out_of_time = [&]
-  {
-    if (!deadline.passed())
-      return false;
-    if (!budget_noted)
-    {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "time budget of %.3g s spent: no further attempts",
-                    budget_s);
-      attempts.emplace_back(buf);
-      budget_noted = true;
-    }
-    return true;
-  };
-  // Below this many unknowns a Newton step (dense LU, ~n³/3) costs less than the 50 warm
-  // sweeps (~50 n²) it would save: on random problems of up to 180 unknowns Newton from
-  // zero took 0.17 ms (median) against 0.67 ms for the chain with sweeps first.
-  constexpr int warm_start_unknowns = 300;
-  if (opt.chain.empty() and p.q.size() >= warm_start_unknowns)
-  {
-    // Default chain: a few projection sweeps first. They are cheap (O((m·d)²) each) and
-    // find the open/stick/slip pattern of most pairs, from where Newton converges in one
-    // or two steps: on 2367 unknowns of a sliding block, 50 sweeps + 2 Newton steps took
-    // 0.85 s against 6.6 s for Newton from zero (22 steps of a dense LU).
-    SolverOptions warm = left();
-    warm.max_iterations = 1; // the projection solver runs 50 × max_iterations sweeps
-    best = solve_projection(p, lambda0, warm);
-    best.solver = "projection";
-    attempts.push_back(attempt_line(best) + " (warm start)");
-    if (opt.verbose)
-      std::cerr << "solve: " << attempts.back() << "\n";
-    have_best = best.lambda.allFinite() && std::isfinite(best.residual);
-    if (!have_best)
-      best = SolveReport{};
-  }
-  for (const auto& name : chain)
-  {
-    if (have_best && best.converged)
-      break;
-    // Two starts per solver: the best answer so far (a near-miss of one solver is often a
-    // good start for the next) and the caller's own (λ0, states0), for when it is not. On
-    // random ill-conditioned problems Newton after the projection sweeps stalled at 1e-5
-    // where Newton from zero converged; the active set from a failed Newton iterate can
-    // switch states thousands of times where from zero it needs a few iterations. So
-    // Newton and the projection start warm, the active set cold, each with the other start
-    // as its second try.
-    const bool warm_first = name != "active_set";
-    const bool had_best = have_best;
-    for (int attempt = 0; attempt < 2 && !(have_best && best.converged); ++attempt)
-    {
-      if (attempt == 1 && !had_best)
-        break; // both starts would be the caller's
-      if (out_of_time())
-        break;
-      const bool warm = had_best && (attempt == 0) == warm_first;
-      SolveReport r = run_solver(name, p, warm ? best.lambda : Vector(lambda0),
-                                 warm ? best.states : states0, left(), !warm);
-      attempts.push_back(attempt_line(r) + (warm ? " (from the best so far)"
-                                                 : " (from the given start)"));
-      keep_best(std::move(r), opt, best, have_best, attempts);
-    }
-    if (name == "newton_ac")
-      for (const auto& variant : newton_variants)
-      {
-        if ((have_best && best.converged) || out_of_time())
-          break;
-        SolveReport r = detail::newton_ac(p, Vector::Zero(p.q.size()), left(), variant.settings);
-        r.solver = name;
-        attempts.push_back(attempt_line(r) + variant.label);
-        keep_best(std::move(r), opt, best, have_best, attempts);
-      }
-  }
-  // The projection can end a little short of an answer (1e-6) from where Newton converges
-  // in two steps, though every Newton before it failed from its own starts: on
-  // ill_conditioned-3d-m49-7335 of the campaign (condition 1e10) the projection reached
-  // 9.7e-7 and Newton from there 3.7e-14. So an answer Newton did not itself end on gets
-  // one last Newton from it.
-  if (have_best && !best.converged && best.solver != "newton_ac" && in_chain("newton_ac")
-      && !out_of_time())
-  {
-    SolveReport r = run_solver("newton_ac", p, best.lambda, best.states, left(), false);
-    attempts.push_back(attempt_line(r) + " (from the best so far, last)");
-    keep_best(std::move(r), opt, best, have_best, attempts);
-  }
-  if (!have_best)
-  {
-    // The budget ran out before any attempt: report the caller's start as it is.
-    best.solver = chain.front();
-    best.lambda = lambda0.size() ? Vector(lambda0) : Vector::Zero(p.q.size());
-    best.u = p.W * best.lambda + p.q;
-    best.residual = natural_map_residual(p, best.lambda);
-    best.converged = best.residual <= opt.tolerance;
-    best.states = classify_states(p, best.lambda, best.u);
-  }
-  if (best.lambda.size() == p.q.size() && best.lambda.allFinite())
-  {
-    const double before = best.residual;
-    zero_undetermined_friction(p, best);
-    // Zeroing can only remove a spurious friction component; it must not spoil an answer.
-    if (best.converged && !(best.residual <= std::max(opt.tolerance, before)))
-      best.converged = false;
-  }
-  best.attempts = std::move(attempts);
-  return best;
+  return ChainRun(p, lambda0, states0, opt).run(chain);
 }
 } // namespace flexcontact

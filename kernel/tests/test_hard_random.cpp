@@ -15,11 +15,10 @@
 #include "contact_testing.hpp"
 #include "flexcontact/residual.hpp"
 #include "flexcontact/solvers.hpp"
+#include "stored_problems.hpp"
 
 #include <gtest/gtest.h>
 
-#include <bit>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -31,9 +30,6 @@
 
 using namespace flexcontact;
 using namespace flexcontact::testing;
-
-static_assert(std::endian::native == std::endian::little,
-              "the stored problems are little-endian");
 
 namespace
 {
@@ -49,20 +45,10 @@ struct Stored
 Stored read_stored(const std::string& name)
 {
   const std::string path = std::string(FLEXCONTACT_TEST_DATA) + "/random/" + name + ".rp";
-  std::ifstream f(path, std::ios::binary);
-  if (!f)
-    throw std::runtime_error(path + ": cannot open");
   Stored s;
   int m = -1;
-  std::string line;
-  std::getline(f, line);
-  if (line != "flexcontact-random-problem 1")
-    throw std::runtime_error(path + ": not a stored random problem ('" + line + "')");
-  while (std::getline(f, line) && line.rfind("binary", 0) != 0)
+  auto on_line = [&](const std::string& key, std::istringstream& in)
   {
-    std::istringstream in(line);
-    std::string key;
-    in >> key;
     if (key == "name")
       in >> s.name;
     else if (key == "dim")
@@ -70,25 +56,22 @@ Stored read_stored(const std::string& name)
     else if (key == "pairs")
       in >> m;
     else
-      throw std::runtime_error(path + ": unknown header line '" + line + "'");
-  }
-  if ((s.dim != 2 && s.dim != 3) || m < 1)
-    throw std::runtime_error(path + ": bad header (dim or pairs)");
+      return false;
+    return true;
+  };
+  auto count = [&]
+  {
+    if ((s.dim != 2 && s.dim != 3) || m < 1)
+      throw std::runtime_error(path + ": bad header (dim or pairs)");
+    const std::size_t n = static_cast<std::size_t>(m) * s.dim;
+    return static_cast<std::size_t>(m) + n * (n + 1) / 2 + 2 * n;
+  };
+  StoredValues v = read_stored_values(path, "flexcontact-random-problem 1", "", on_line, count);
   const Eigen::Index n = static_cast<Eigen::Index>(m) * s.dim;
-  std::vector<double> v(static_cast<std::size_t>(m + n * (n + 1) / 2 + 2 * n));
-  f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(v.size() * 8));
-  if (!f || f.peek() != std::char_traits<char>::eof())
-    throw std::runtime_error(path + ": binary part is not exactly " + std::to_string(v.size())
-                             + " float64 values");
-  std::size_t k = 0;
-  s.mu = Eigen::Map<const Vector>(v.data(), m);
-  k += static_cast<std::size_t>(m);
-  s.W.resize(n, n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = i; j < n; ++j)
-      s.W(i, j) = s.W(j, i) = v[k++];
-  s.q = Eigen::Map<const Vector>(v.data() + k, n);
-  s.lambda_star = Eigen::Map<const Vector>(v.data() + k + n, n);
+  s.mu = v.take(m);
+  s.W = v.take_symmetric(n);
+  s.q = v.take(n);
+  s.lambda_star = v.take(n);
   return s;
 }
 

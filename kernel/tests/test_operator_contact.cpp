@@ -11,6 +11,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
 using namespace flexcontact;
 using namespace flexcontact::testing;
 
@@ -104,4 +109,74 @@ TEST(OperatorContact, NotConvergedIsAConvergenceError)
     EXPECT_FALSE(e.report.converged);
     EXPECT_NE(std::string(e.what()).find("contact_operator='factor'"), std::string::npos);
   }
+}
+
+namespace
+{
+/// @brief What `make` throws, with the object's name taken out, so that the dense and the
+/// operator objects' messages can be compared word for word.
+std::string message_without(const std::string& name, const std::function<void()>& make)
+{
+  std::string m = message_of(make);
+  const auto at = m.find(name);
+  return at == std::string::npos ? "(no '" + name + "' in: " + m + ")" : m.erase(at, name.size());
+}
+} // namespace
+
+TEST(OperatorContact, BadArgumentsReadAsForTheDenseObject)
+{
+  // Two nodes (slave 0 above master 1), one pair, F* = I: every bad argument must be refused
+  // before anything is computed, in the words CondensedContact uses.
+  const Matrix X = (Matrix(2, 2) << 0.5, 0.1, 0.5, 0.0).finished();
+  const std::vector<ContactPair> pair = {make_pair(0, {1}, {1.0}, vec({0.0, 1.0}))};
+  const Matrix F = Matrix::Identity(4, 4);
+  const LinearOperator Fop = [&F](const Vector& r) { return Vector(F * r); };
+  struct Case
+  {
+    int dim;
+    Matrix X;
+    Vector mu;
+    std::vector<bool> constrained;
+  };
+  const Matrix X_nan = (Matrix(2, 2) << 0.5, NAN, 0.5, 0.0).finished();
+  const std::vector<Case> cases = {
+      {4, X, vec({0.3}), {}},                  // dim
+      {2, Matrix::Zero(2, 3), vec({0.3}), {}}, // X's columns
+      {2, X_nan, vec({0.3}), {}},              // X not finite
+      {2, X, vec({0.3, 0.1}), {}},             // one μ per pair
+      {2, X, vec({0.3}), {true, false}},       // constrained's size
+  };
+  for (const Case& c : cases)
+  {
+    const std::string dense = message_without(
+        "CondensedContact: ", [&] { CondensedContact(c.dim, F, c.X, pair, c.mu, c.constrained); });
+    const std::string op = message_without(
+        "OperatorContact: ", [&] { OperatorContact(c.dim, Fop, c.X, pair, c.mu, c.constrained); });
+    EXPECT_FALSE(dense.empty());
+    EXPECT_EQ(op, dense);
+  }
+
+  CondensedContact dense(2, F, X, pair, vec({0.3}));
+  OperatorContact op(2, Fop, X, pair, vec({0.3}));
+  for (const Vector& up : {vec({0.0, 0.0}), vec({0.0, NAN, 0.0, 0.0})})
+    EXPECT_EQ(message_without("OperatorContact: ", [&] { op.step(up); }),
+              message_without("CondensedContact: ", [&] { dense.step(up); }));
+}
+
+TEST(OperatorContact, BadFrictionOnRepairingKeepsThePairs)
+{
+  // A negative μ is refused before the pairs are replaced: the object keeps its pairs and μ
+  // and still solves (a pushed pair closes).
+  const Matrix X = (Matrix(2, 2) << 0.5, 0.1, 0.5, 0.0).finished();
+  const std::vector<ContactPair> pair = {make_pair(0, {1}, {1.0}, vec({0.0, 1.0}))};
+  const Matrix F = Matrix::Identity(4, 4);
+  OperatorContact op(2, [&F](const Vector& r) { return Vector(F * r); }, X, pair, vec({0.3}));
+  const std::string what = message_of([&] { op.set_pairs(pair, vec({-0.5})); });
+  EXPECT_NE(what.find("friction coefficient of pair 0 is -0.5"), std::string::npos) << what;
+  ASSERT_EQ(op.pairs(), 1);
+  EXPECT_EQ(op.mu()[0], 0.3);
+  // Slave pushed 0.2 down onto the master 0.1 below it: with F* = I, W_nn = 2 and the normal
+  // force closes the gap, λ_n = (0.2 − 0.1)/2.
+  const CondensedStep r = op.step(vec({0.0, -0.2, 0.0, 0.0}));
+  EXPECT_NEAR(r.lambda[0], 0.05, 1e-9);
 }

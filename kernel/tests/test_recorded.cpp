@@ -13,13 +13,12 @@
 
 #include "contact_testing.hpp"
 #include "flexcontact/solvers.hpp"
+#include "stored_problems.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <bit>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <ostream>
@@ -35,9 +34,6 @@
 
 using namespace flexcontact;
 using namespace flexcontact::testing;
-
-static_assert(std::endian::native == std::endian::little,
-              "the recorded problems are stored little-endian");
 
 namespace
 {
@@ -73,20 +69,10 @@ std::vector<PairState> read_states(std::istringstream& in)
 Recorded read_recorded(const std::string& name)
 {
   const std::string path = std::string(FLEXCONTACT_TEST_DATA) + "/" + name + ".lp";
-  std::ifstream f(path, std::ios::binary);
-  if (!f)
-    throw std::runtime_error(path + ": cannot open (run tests/data/record.py)");
   Recorded r;
   int m = -1;
-  std::string line;
-  std::getline(f, line);
-  if (line != "flexcontact-local-problem 1")
-    throw std::runtime_error(path + ": not a recorded local problem (first line '" + line + "')");
-  while (std::getline(f, line) && line.rfind("binary", 0) != 0)
+  auto on_line = [&](const std::string& key, std::istringstream& in)
   {
-    std::istringstream in(line);
-    std::string key;
-    in >> key;
     if (key == "source")
       std::getline(in >> std::ws, r.source);
     else if (key == "dim")
@@ -102,31 +88,24 @@ Recorded read_recorded(const std::string& name)
     else if (key == "residual")
       in >> r.residual;
     else
-      throw std::runtime_error(path + ": unknown header line '" + line + "'");
-  }
-  if ((r.dim != 2 && r.dim != 3) || m < 1 || static_cast<int>(r.states.size()) != m)
-    throw std::runtime_error(path + ": bad header (dim, pairs or states)");
-  const Eigen::Index n = static_cast<Eigen::Index>(m) * r.dim;
-  std::vector<double> v(static_cast<std::size_t>(m + n * (n + 1) / 2 + 3 * n));
-  f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(v.size() * 8));
-  if (!f || f.peek() != std::char_traits<char>::eof())
-    throw std::runtime_error(path + ": binary part is not exactly " + std::to_string(v.size())
-                             + " float64 values");
-  std::size_t k = 0;
-  auto take = [&](Eigen::Index len)
-  {
-    Vector x = Eigen::Map<const Vector>(v.data() + k, len);
-    k += static_cast<std::size_t>(len);
-    return x;
+      return false;
+    return true;
   };
-  r.mu = take(m);
-  r.W.resize(n, n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = i; j < n; ++j)
-      r.W(i, j) = r.W(j, i) = v[k++];
-  r.q = take(n);
-  r.lambda = take(n);
-  r.lambda_previous = take(n);
+  auto count = [&]
+  {
+    if ((r.dim != 2 && r.dim != 3) || m < 1 || static_cast<int>(r.states.size()) != m)
+      throw std::runtime_error(path + ": bad header (dim, pairs or states)");
+    const std::size_t n = static_cast<std::size_t>(m) * r.dim;
+    return static_cast<std::size_t>(m) + n * (n + 1) / 2 + 3 * n;
+  };
+  StoredValues v = read_stored_values(path, "flexcontact-local-problem 1",
+                                      " (run tests/data/record.py)", on_line, count);
+  const Eigen::Index n = static_cast<Eigen::Index>(m) * r.dim;
+  r.mu = v.take(m);
+  r.W = v.take_symmetric(n);
+  r.q = v.take(n);
+  r.lambda = v.take(n);
+  r.lambda_previous = v.take(n);
   return r;
 }
 

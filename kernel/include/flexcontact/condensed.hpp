@@ -125,13 +125,6 @@ public:
   int contact_dofs() const { return static_cast<int>(F_.rows()); } ///< n_c
 
 private:
-  /// @brief For each of the new pairs, the index of the current pair of its slave node
-  /// (−1 if it had none).
-  std::vector<int> previous_pair_of(const std::vector<ContactPair>& pairs) const;
-  /// @brief The warm start of the new pairs: λ and states carried over by slave node.
-  Vector carried_force(const std::vector<ContactPair>& pairs) const;
-  std::vector<PairState> carried_states(const std::vector<ContactPair>& pairs) const;
-
   /// @brief Message naming held pairs pushed into penetration by q, or empty.
   std::string held_and_penetrating(const Vector& q) const;
 

@@ -84,7 +84,6 @@ public:
 
 private:
   Vector flex(Vector r) const;
-  std::vector<int> previous_pair_of(const std::vector<ContactPair>& pairs) const;
 
   int dim_;
   LinearOperator F_;
