@@ -43,7 +43,7 @@ from flexcontact.info import describe  # noqa: E402
 INCREMENTS = 20
 # (dim, kind, refine, loadings): the 3D Hertz mesh at about 60k DOFs (hertz3d --refine 1).
 DEFAULT = [(2, "hertz", 1, ("single", "incremental")), (2, "rigid", 1, ("single", "incremental")),
-           (3, "hertz", 1, ("single", "incremental")), (3, "rigid", 1, ("single",))]
+           (3, "hertz", 1, ("single", "incremental")), (3, "rigid", 1, ("single", "incremental"))]
 FULL = [(2, "hertz", 3, ("single", "incremental")), (2, "rigid", 3, ("single", "incremental")),
         (3, "hertz", 1, ("single", "incremental")), (3, "rigid", 1, ("single", "incremental"))]
 
@@ -173,7 +173,7 @@ def merge(old: dict, new: dict) -> dict:
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--full", action="store_true",
-                        help="2D at --refine 3 and the 20-increment loading in 3D")
+                        help="the 2D meshes at --refine 3")
     parser.add_argument("--out", default=str(HERE / "peers.json"), help="JSON file to write")
     parser.add_argument("--cases", nargs="+", metavar="NAME",
                         help="only these cases (hertz2d rigid2d hertz3d rigid3d), merged into "
