@@ -102,8 +102,10 @@ Eigen::VectorXd FactorFlexibility::operator()(const Eigen::VectorXd& r) const
 
 int FactorFlexibility::columns_per_solve() const
 {
-  const double bytes = 128e6, per_column = 2.0 * 8.0 * static_cast<double>(std::max<PetscInt>(N_, 1));
-  return static_cast<int>(std::clamp(bytes / per_column, 1.0, 256.0));
+  // Small against the dense path's n_c² so as not to move the memory crossover; past a few
+  // dozen columns a block solve gains little more per column.
+  const double bytes = 32e6, per_column = 2.0 * 8.0 * static_cast<double>(std::max<PetscInt>(N_, 1));
+  return static_cast<int>(std::clamp(bytes / per_column, 1.0, 128.0));
 }
 
 Eigen::MatrixXd FactorFlexibility::block(const Eigen::MatrixXd& R) const

@@ -39,7 +39,7 @@ public:
   Eigen::MatrixXd block(const Eigen::MatrixXd& R) const;
 
   /// @brief Columns per MatMatSolve: its dense right-hand side and solution hold N values per
-  /// column (N = K's size), kept to about 128 MB together, at most 256 columns.
+  /// column (N = K's size), kept to about 32 MB together, at most 128 columns.
   int columns_per_solve() const;
 
   int contact_dofs() const { return static_cast<int>(dofs_.size()) + n_virtual_; }
