@@ -160,11 +160,11 @@ def _zone_row(n_c: int, by: dict, dim: int) -> dict:
 def analyse(runs: list[dict], dim: int, mem_total_b: float) -> dict:
     """The dense path's extra memory as c·n_c², where its peak passes the machine, the
     estimate's calibration, the memory crossover and the speed ratios per zone."""
-    by_nc = {}
+    by_zone = {}  # (n_c, DOFs): two meshes may have the same n_c
     for r in runs:
         if "error" not in r and "raised" not in r and r["dim"] == dim and not r["spec"].get("env"):
-            by_nc.setdefault(r["contact_dofs"], {})[r["spec"]["path"]] = r
-    rows = [_zone_row(n_c, by, dim) for n_c, by in sorted(by_nc.items())
+            by_zone.setdefault((r["contact_dofs"], r["dofs"]), {})[r["spec"]["path"]] = r
+    rows = [_zone_row(key[0], by, dim) for key, by in sorted(by_zone.items())
             if {"dense", "factor"} <= set(by)]
     out = {"dim": dim, "zones": rows}
     big = [r for r in rows if r.get("dense_extra_mb", 0) > 0]
@@ -241,7 +241,15 @@ def main():
     ap.add_argument("--increments", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=1800.0, help="per run (s)")
     ap.add_argument("--out", default=str(HERE / "large_contact.json"))
+    ap.add_argument("--analyse", action="store_true",
+                    help="recompute the analysis of the runs already in --out")
     args = ap.parse_args()
+    if args.analyse:
+        result = json.loads(Path(args.out).read_text())
+        for d, dim in (("2d", 2), ("3d", 3)):
+            result[d] = analyse(result["runs"], dim, result["mem_total_bytes"])
+        Path(args.out).write_text(json.dumps(result, indent=1))
+        return
     if args.child:
         print("RESULT " + json.dumps(child(json.loads(args.child))), flush=True)
         return
