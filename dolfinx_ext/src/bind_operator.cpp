@@ -67,8 +67,13 @@ void flexcontact::bind_operator(py::module& m)
                  c.contact = std::make_unique<OperatorContact>(
                      dim, [F](const Vector& r) { return (*F)(r); }, std::move(X),
                      std::move(pairs), std::move(mu), std::move(held), options);
+                 SameOnAllRanks same;
+                 int size = 1;
+                 MPI_Comm_size(PetscObjectComm(reinterpret_cast<PetscObject>(K)), &size);
+                 if (size > 1)
+                   same = [F](long v) { F->same_on_all_ranks(v); };
                  c.contact->use_working_set([F](const Matrix& R) { return F->block(R); },
-                                            working_set_bytes);
+                                            working_set_bytes, same);
                  return c;
                }),
            py::arg("dim"), py::arg("factor"), py::arg("K"), py::arg("dofs"),

@@ -100,6 +100,17 @@ Eigen::VectorXd FactorFlexibility::operator()(const Eigen::VectorXd& r) const
   return out;
 }
 
+void FactorFlexibility::same_on_all_ranks(long value) const
+{
+  long lo = 0, hi = 0;
+  MPI_Allreduce(&value, &lo, 1, MPI_LONG, MPI_MIN, comm_);
+  MPI_Allreduce(&value, &hi, 1, MPI_LONG, MPI_MAX, comm_);
+  if (lo != hi)
+    throw std::runtime_error("FactorFlexibility: the ranks' working sets diverged ("
+                             + std::to_string(lo) + " against " + std::to_string(hi)
+                             + "): the replicated contact solve is no longer the same");
+}
+
 int FactorFlexibility::columns_per_solve() const
 {
   // Small against the dense path's n_c² so as not to move the memory crossover; past a few

@@ -38,6 +38,9 @@ public:
   /// Collective; throws on every rank if the ranks ask for different k.
   Eigen::MatrixXd block(const Eigen::MatrixXd& R) const;
 
+  /// @brief Throws on every rank if the ranks passed different values (collective).
+  void same_on_all_ranks(long value) const;
+
   /// @brief Columns per MatMatSolve: its dense right-hand side and solution hold N values per
   /// column (N = K's size), kept to about 32 MB together, at most 128 columns.
   int columns_per_solve() const;

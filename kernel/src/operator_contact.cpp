@@ -117,10 +117,12 @@ void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   columns_.slot.assign(pairs_.size(), -1);
 }
 
-void OperatorContact::use_working_set(BlockOperator block, double max_bytes)
+void OperatorContact::use_working_set(BlockOperator block, double max_bytes,
+                                      SameOnAllRanks same)
 {
   block_ = std::move(block);
   max_bytes_ = block_ ? max_bytes : 0.0;
+  same_ = std::move(same);
 }
 
 Matrix OperatorContact::W_columns(const std::vector<int>& pairs) const
@@ -203,7 +205,7 @@ SolveReport OperatorContact::solve_local(const Vector& q)
   {
     ws = solve_working_set(dim_, columns_,
                            [this](const std::vector<int>& p) { return fetch_columns(p); }, q,
-                           mu_, lambda_, states_, options_);
+                           mu_, lambda_, states_, options_, same_);
     if (ws.converged)
       return ws;
   }

@@ -253,7 +253,8 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
                               const Eigen::Ref<const Vector>& q,
                               const Eigen::Ref<const Vector>& mu,
                               const Eigen::Ref<const Vector>& lambda0,
-                              const std::vector<PairState>& states0, const SolverOptions& opt)
+                              const std::vector<PairState>& states0, const SolverOptions& opt,
+                              const SameOnAllRanks& same)
 {
   const Eigen::Index n = q.size();
   const int m = static_cast<int>(n / dim);
@@ -291,6 +292,8 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
     const Restricted r = restrict_to(columns, A, dim, q, mu, out.lambda, states0);
     const SolveReport rep = solve(ProblemView{dim, r.W, r.q, r.mu}, r.lambda, r.states, opt);
     inner += rep.iterations;
+    if (same) // the chain stops on a wall-clock budget: all ranks must agree on its outcome
+      same(rep.converged ? static_cast<long>(A.size()) : -1L);
     out.lambda.setZero();
     for (std::size_t a = 0; a < A.size(); ++a)
       out.lambda.segment(A[a] * dim, dim) = rep.lambda.segment(static_cast<Eigen::Index>(a) * dim, dim);
@@ -313,6 +316,8 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
         in[static_cast<std::size_t>(k)] = 1;
         A.push_back(k);
       }
+    if (same)
+      same(static_cast<long>(A.size()));
     if (A.size() == before)
     {
       out.u = std::move(u);

@@ -38,6 +38,10 @@ struct PairColumns
 /// they would pass the memory allowed (nothing fetched then).
 using FetchColumns = std::function<bool(const std::vector<int>& pairs)>;
 
+/// @brief Checks that every rank running the same iteration reached the same value, and
+/// throws on every rank if not (collective); empty in serial.
+using SameOnAllRanks = std::function<void(long value)>;
+
 /// @brief Scales of a matrix-free local problem: a step from ‖W‖ and the natural-map ρ.
 struct OperatorScales
 {
@@ -71,12 +75,15 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
 /// the whole natural-map residual (any ρ outside the set) is at most the restricted one,
 /// which is reported. Each round fetches only the new pairs' columns (one block product).
 /// Returns converged=false (its last λ, and a line in `attempts`) if the set passes the
-/// memory `fetch` allows, the chain fails, or 50 rounds pass; never throws on that.
+/// memory `fetch` allows, the chain fails, or 50 rounds pass; never throws on that. After
+/// each round `same` (if given) checks that every rank took the same branch with the same
+/// set: the chain has a wall-clock budget, and ranks must not part ways in collective solves.
 SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchColumns& fetch,
                               const Eigen::Ref<const Vector>& q,
                               const Eigen::Ref<const Vector>& mu,
                               const Eigen::Ref<const Vector>& lambda0,
-                              const std::vector<PairState>& states0, const SolverOptions& opt);
+                              const std::vector<PairState>& states0, const SolverOptions& opt,
+                              const SameOnAllRanks& same = {});
 
 /// @brief Pairs, B, x0 and the incremental driver of CondensedContact, with F* an operator.
 ///
@@ -111,7 +118,7 @@ public:
   /// @brief Solve increments on a working set of W's columns (solve_working_set), computed
   /// through `block` (F* on many columns at once) and held within `max_bytes` (8 bytes per
   /// entry of the m·d × d·pairs columns); max_bytes ≤ 0 turns it off.
-  void use_working_set(BlockOperator block, double max_bytes);
+  void use_working_set(BlockOperator block, double max_bytes, SameOnAllRanks same = {});
 
   /// @brief W[:, pairs] (m·d × d·|pairs|) through one block product (constrained DOFs as in
   /// apply_W).
@@ -158,6 +165,7 @@ private:
   mutable long applications_ = 0;
   BlockOperator block_;
   double max_bytes_ = 0.0;
+  SameOnAllRanks same_;
   PairColumns columns_;
   mutable long block_columns_ = 0, block_products_ = 0;
 };
