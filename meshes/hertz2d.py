@@ -33,7 +33,7 @@ def gap(x, R):
 
 def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
           zone_factor=2.5, block_width=None, block_depth=None, block_spacing=None,
-          with_cylinder=True):
+          with_cylinder=True, fine_depth=None):
     """Build the mesh on ``comm``; returns ``(mesh, cell_tags, facet_tags, info)``.
 
     Args:
@@ -49,6 +49,9 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
             nodes, each slave node above its master node).
         with_cylinder: False builds the block alone (for a rigid circle as the target; no
             UPPER, LOADED or SLAVE tags).
+        fine_depth: depth (m) of the layer meshed at h_contact along the zone, the size
+            growing beyond it; default w/4. A few h_contact keep a wide, finely spaced zone
+            (many contact DOFs) from filling the bodies with elements.
 
     ``info`` holds R, a_expected, w, h_contact (the actual zone spacing), h_far,
     block_width, block_depth and n_contact_nodes (per surface).
@@ -65,6 +68,7 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         raise ValueError(
             f"h_contact={h!r} (after refine={refine}) exceeds the zone half-width w={w!r}")
     hf = max(hf, h)
+    near = 0.25 * w if fine_depth is None else _check.positive("fine_depth", fine_depth)
 
     n = math.ceil(w / h - 1e-9)          # segments per side of x = 0
     xs = [w * i / n for i in range(-n, n + 1)]  # symmetric; x = 0 is a node of both bodies
@@ -101,7 +105,6 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         if not with_cylinder:
             geo.synchronize()
             block_groups()
-            near = 0.25 * w
             _gmsh.size_field(seg_m, 1, h, hf, near, near + 3 * (hf - h), points_per_curve=4)
             gmsh.model.mesh.generate(2)
             return info
@@ -122,7 +125,6 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
         _gmsh.physical(1, [top], LOADED, NAMES[LOADED])
         _gmsh.physical(1, seg_s, SLAVE, NAMES[SLAVE])
 
-        near = 0.25 * w
         _gmsh.size_field(seg_m + seg_s, 1, h, hf, near, near + 3 * (hf - h), points_per_curve=4)
         gmsh.model.mesh.generate(2)
         return info

@@ -20,7 +20,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import compat, forms
-from flexcontact.memory import ENV_AVAILABLE, dense_bytes
+from flexcontact.memory import ENV_AVAILABLE, ENV_WORKING_SET, dense_bytes
 from flexcontact.meshes import hertz2d, hertz3d, tags
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -66,11 +66,15 @@ def run(dim, mu, operator, build, increments=2, comm=MPI.COMM_WORLD):
     return problem, out, u.norm()
 
 
-@pytest.mark.parametrize("mu", [0.0, 0.3])
-def test_factor_path_matches_dense_on_2d_hertz(mu):
+@pytest.mark.parametrize("mu, working_set", [(0.0, None), (0.3, None), (0.3, "0")])
+def test_factor_path_matches_dense_on_2d_hertz(mu, working_set, monkeypatch):
+    # working_set "0": no columns of W held, the matrix-free iteration alone.
+    if working_set is not None:
+        monkeypatch.setenv(ENV_WORKING_SET, working_set)
     build = {"refine": 0, "zone_factor": 1.25}
     dense, d_inc, d_norm = run(2, mu, "dense", build)
     fact, f_inc, f_norm = run(2, mu, "factor", build)
+    solver = "operator" if working_set == "0" else "working_set"
     assert fact.W is None and fact.flex_info["method"] == "factor"
     assert abs(f_norm - d_norm) <= AGREE * d_norm
     if MPI.COMM_WORLD.rank == 0:
@@ -80,8 +84,32 @@ def test_factor_path_matches_dense_on_2d_hertz(mu):
             assert np.abs(a.lam - b.lam).max() <= AGREE * scale
             assert np.abs(a.gap - b.gap).max() <= AGREE * np.abs(a.gap).max()
             assert np.array_equal(a.states > 0, b.states > 0)
-            assert b.summary.solver == "operator" and b.summary.residual < 1e-10
+            assert b.summary.solver == solver and b.summary.residual < 1e-10
             assert b.summary.iterations > 0
+    if working_set is None:
+        # Each pair's columns computed once over both increments (kept between them), every
+        # pair that closed among them, and no single back-substitution in the local solve.
+        assert fact.contact.block_columns == 2 * fact.contact.cached_pairs <= 2 * fact.m
+        if MPI.COMM_WORLD.rank == 0:
+            closed = {k for inc in f_inc for k in np.flatnonzero(inc.states > 0)}
+            assert 0 < len(closed) <= fact.contact.cached_pairs
+        assert fact.contact.applications == 0
+
+
+def test_factor_columns_of_W_are_the_dense_ones():
+    # W[:, pairs] through blocks of back-substitutions against the dense path's W.
+    if MPI.COMM_WORLD.size > 1:
+        pytest.skip("the dense W is on rank 0 only")
+    build = {"refine": 0, "zone_factor": 1.25}
+    dense, _, _ = hertz(2, 0.3, "dense", build)
+    fact, _, _ = hertz(2, 0.3, "factor", build)
+    some = [0, fact.m // 2, fact.m - 1]
+    cols = fact.contact.W_columns(some)
+    W = np.asarray(dense.W)
+    ref = np.hstack([W[:, 2 * k:2 * k + 2] for k in some])
+    assert cols.shape == ref.shape
+    assert np.abs(cols - ref).max() <= 1e-9 * np.abs(W).max()
+    assert fact.contact.block_columns == 2 * len(some)
 
 
 def test_factor_path_matches_dense_in_3d():

@@ -149,8 +149,18 @@ def test_refine_halves_sizes():
     assert 3.0 < ratio < 5.0
 
 
+def test_fine_depth_thins_the_mesh_not_the_zone():
+    # The fine layer's depth (w/4 by default, 3 h here: 12.5 h against 3 h on a zone of
+    # 50 segments a side) changes the cells, not the zone's transfinite contact nodes.
+    m0, _, _, i0 = meshes.hertz2d.build(COMM, zone_factor=5.0)
+    m1, _, _, i1 = meshes.hertz2d.build(COMM, zone_factor=5.0, fine_depth=3 * i0["h_contact"])
+    assert i1["n_contact_nodes"] == i0["n_contact_nodes"] == 101
+    assert m1.topology.index_map(2).size_global < 0.5 * m0.topology.index_map(2).size_global
+
+
 @pytest.mark.parametrize("builder, kwargs, word", [
     (meshes.hertz2d.build, dict(a_expected=0.06), "a_expected=0.06"),
+    (meshes.hertz2d.build, dict(fine_depth=-1.0), "fine_depth=-1.0"),
     (meshes.hertz2d.build, dict(refine=-1), "refine=-1"),
     (meshes.hertz2d.build, dict(R=0.0), "R=0.0"),
     (meshes.hertz2d.build, dict(zone_factor=15.0), "zone half-width"),

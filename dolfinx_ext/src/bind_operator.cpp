@@ -48,7 +48,8 @@ void flexcontact::bind_operator(py::module& m)
                [](int dim, std::uintptr_t factor_handle, std::uintptr_t K_handle,
                   const DofArray& dofs, int n_virtual, Matrix X,
                   std::vector<ContactPair> pairs, Vector mu,
-                  const std::optional<BoolArray>& constrained, const SolverOptions& options)
+                  const std::optional<BoolArray>& constrained, const SolverOptions& options,
+                  double working_set_bytes)
                {
                  // petsc4py's handles (Mat.handle), not its C API: petsc_caster.h's import
                  // state belongs to the one translation unit that loads it.
@@ -62,15 +63,26 @@ void flexcontact::bind_operator(py::module& m)
                  c.contact = std::make_unique<OperatorContact>(
                      dim, [F](const Vector& r) { return (*F)(r); }, std::move(X),
                      std::move(pairs), std::move(mu), flags(constrained), options);
+                 SameOnAllRanks same;
+                 int size = 1;
+                 MPI_Comm_size(PetscObjectComm(reinterpret_cast<PetscObject>(K)), &size);
+                 if (size > 1)
+                   same = [F](long v) { F->same_on_all_ranks(v); };
+                 c.contact->use_working_set([F](const Matrix& R) { return F->block(R); },
+                                            working_set_bytes, same);
                  return c;
                }),
            py::arg("dim"), py::arg("factor"), py::arg("K"), py::arg("dofs"),
            py::arg("n_virtual"), py::arg("X"), py::arg("pairs"), py::arg("mu"),
            py::arg("constrained") = py::none(), py::arg("options") = SolverOptions(),
+           py::arg("working_set_bytes") = 0.0,
            "factor, K: petsc4py Mat.handle of the factored K and of K (for its layout); "
            "dofs: global indices of the real contact DOFs (the same on every rank); "
            "n_virtual: trailing contact DOFs with no PETSc DOF; "
-           "X, pairs, mu, constrained, options as CondensedContact")
+           "X, pairs, mu, constrained, options as CondensedContact; "
+           "working_set_bytes: memory for W's columns of the pairs in contact (the working-set "
+           "solve, by blocks of right-hand sides); 0: the matrix-free iteration only. The "
+           "same value on every rank.")
       .def(
           "step",
           [convergence_error](FactorContact& c, const Vector& up_c)
@@ -106,6 +118,24 @@ void flexcontact::bind_operator(py::module& m)
       .def_property_readonly(
           "frames", [](const FactorContact& c)
           { return frames_array(c.contact->contact_pairs(), c.contact->dim()); })
+      .def(
+          "W_columns",
+          [](FactorContact& c, std::vector<int> pairs)
+          {
+            py::gil_scoped_release release;
+            return c.contact->W_columns(pairs);
+          },
+          py::arg("pairs"),
+          "W[:, pairs] (m·d × d·len(pairs)) by one block of back-substitutions. Collective.")
+      .def_property_readonly("block_columns",
+                             [](const FactorContact& c) { return c.contact->block_columns(); },
+                             "columns F* was applied to in blocks so far")
+      .def_property_readonly("block_products",
+                             [](const FactorContact& c) { return c.contact->block_products(); },
+                             "block products (each one or a few multi-RHS solves) so far")
+      .def_property_readonly("cached_pairs",
+                             [](const FactorContact& c) { return c.contact->cached_pairs(); },
+                             "pairs whose columns of W are held now")
       .def_property_readonly("applications",
                              [](const FactorContact& c) { return c.contact->applications(); },
                              "F* products (back-substitutions) so far")

@@ -33,6 +33,18 @@ public:
   /// @brief F* r (n_c = dofs + n_virtual values in, the same out). Collective.
   Eigen::VectorXd operator()(const Eigen::VectorXd& r) const;
 
+  /// @brief F* R for the columns of R (n_c × k) by multi-right-hand-side solves (MUMPS
+  /// solves many columns for little more than one), in chunks of columns_per_solve().
+  /// Collective; throws on every rank if the ranks ask for different k.
+  Eigen::MatrixXd block(const Eigen::MatrixXd& R) const;
+
+  /// @brief Throws on every rank if the ranks passed different values (collective).
+  void same_on_all_ranks(long value) const;
+
+  /// @brief Columns per MatMatSolve: its dense right-hand side and solution hold N values per
+  /// column (N = K's size), kept to about 32 MB together, at most 128 columns.
+  int columns_per_solve() const;
+
   int contact_dofs() const { return static_cast<int>(dofs_.size()) + n_virtual_; }
 
 private:
@@ -41,6 +53,7 @@ private:
   VecScatter gather_ = nullptr;
   std::vector<PetscInt> dofs_;
   int n_virtual_ = 0;
-  PetscInt lo_ = 0, hi_ = 0;
+  PetscInt lo_ = 0, hi_ = 0, N_ = 0;
+  MPI_Comm comm_ = MPI_COMM_NULL;
 };
 } // namespace flexcontact

@@ -75,8 +75,111 @@ void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   states_ = std::move(states);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
-  scales_ = operator_scales([this](const Vector& v) { return apply_W(v); }, dim_,
-                            static_cast<int>(pairs_.size()));
+  // Both depend on B: the scales are estimated again when solve_operator next runs.
+  scales_ = OperatorScales{};
+  columns_ = PairColumns{};
+  columns_.slot.assign(pairs_.size(), -1);
+}
+
+void OperatorContact::use_working_set(BlockOperator block, double max_bytes,
+                                      SameOnAllRanks same)
+{
+  block_ = std::move(block);
+  max_bytes_ = block_ ? max_bytes : 0.0;
+  same_ = std::move(same);
+}
+
+Matrix OperatorContact::W_columns(const std::vector<int>& pairs) const
+{
+  if (!block_)
+    throw std::logic_error(who + "W_columns needs a block operator (use_working_set)");
+  const int d = dim_;
+  const Eigen::SparseMatrix<double> Bt = B_.transpose();
+  Matrix R = Matrix::Zero(contact_dofs(), static_cast<Eigen::Index>(pairs.size()) * d);
+  for (std::size_t a = 0; a < pairs.size(); ++a)
+  {
+    if (pairs[a] < 0 || pairs[a] >= this->pairs())
+      throw std::invalid_argument(who + "W_columns: pair " + std::to_string(pairs[a])
+                                  + " out of range");
+    for (int i = 0; i < d; ++i)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(Bt, pairs[a] * d + i); it; ++it)
+        R(it.row(), static_cast<Eigen::Index>(a) * d + i) = it.value();
+  }
+  for (std::size_t i = 0; i < constrained_.size(); ++i)
+    if (constrained_[i])
+      R.row(static_cast<Eigen::Index>(i)).setZero();
+  Matrix F = block_(R);
+  ++block_products_;
+  block_columns_ += R.cols();
+  if (F.rows() != R.rows() || F.cols() != R.cols())
+    throw std::runtime_error(who + "the block operator returned " + std::to_string(F.rows())
+                             + "×" + std::to_string(F.cols()) + " for "
+                             + std::to_string(R.rows()) + "×" + std::to_string(R.cols()));
+  for (std::size_t i = 0; i < constrained_.size(); ++i)
+    if (constrained_[i])
+      F.row(static_cast<Eigen::Index>(i)).setZero();
+  return B_ * F;
+}
+
+bool OperatorContact::fetch_columns(const std::vector<int>& pairs)
+{
+  std::vector<int> missing;
+  for (int k : pairs)
+    if (columns_.slot[static_cast<std::size_t>(k)] < 0)
+      missing.push_back(k);
+  if (missing.empty())
+    return true;
+  const int d = dim_;
+  const double per_pair = 8.0 * static_cast<double>(B_.rows()) * d;
+  auto fits = [&](std::size_t count) { return per_pair * static_cast<double>(count) <= max_bytes_; };
+  if (!fits(pairs.size()))
+    return false;
+  if (!fits(columns_.order.size() + missing.size()))
+  {
+    // Keep only the pairs asked for now: earlier increments' columns make room.
+    PairColumns kept;
+    kept.slot.assign(pairs_.size(), -1);
+    kept.columns.resize(B_.rows(), static_cast<Eigen::Index>(pairs.size() - missing.size()) * d);
+    for (int k : pairs)
+      if (const int s = columns_.slot[static_cast<std::size_t>(k)]; s >= 0)
+      {
+        kept.slot[static_cast<std::size_t>(k)] = static_cast<int>(kept.order.size());
+        kept.columns.middleCols(static_cast<Eigen::Index>(kept.order.size()) * d, d)
+            = columns_.columns.middleCols(static_cast<Eigen::Index>(s) * d, d);
+        kept.order.push_back(k);
+      }
+    columns_ = std::move(kept);
+  }
+  const Matrix fresh = W_columns(missing);
+  const Eigen::Index old = columns_.columns.cols();
+  columns_.columns.conservativeResize(B_.rows(), old + fresh.cols());
+  columns_.columns.rightCols(fresh.cols()) = fresh;
+  for (int k : missing)
+  {
+    columns_.slot[static_cast<std::size_t>(k)] = static_cast<int>(columns_.order.size());
+    columns_.order.push_back(k);
+  }
+  return true;
+}
+
+SolveReport OperatorContact::solve_local(const Vector& q)
+{
+  SolveReport ws;
+  if (block_ && max_bytes_ > 0.0)
+  {
+    ws = solve_working_set(dim_, columns_,
+                           [this](const std::vector<int>& p) { return fetch_columns(p); }, q,
+                           mu_, lambda_, states_, options_, same_);
+    if (ws.converged)
+      return ws;
+  }
+  auto W = [this](const Vector& v) { return apply_W(v); };
+  if (scales_.applications == 0 && !pairs_.empty())
+    scales_ = operator_scales(W, dim_, pairs());
+  const Vector start = ws.lambda.size() == q.size() ? ws.lambda : lambda_;
+  SolveReport r = solve_operator(dim_, W, scales_, q, mu_, start, options_);
+  r.attempts.insert(r.attempts.begin(), ws.attempts.begin(), ws.attempts.end());
+  return r;
 }
 
 CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
@@ -90,15 +193,16 @@ CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
   for (int k = 0; k < m; ++k)
     for (int j = 1; j < d; ++j)
       r.local_q[k * d + j] -= x_[k * d + j];
-  const long before = applications_;
-  r.report = solve_operator(d, [this](const Vector& v) { return apply_W(v); }, scales_,
-                            r.local_q, mu_, lambda_, options_);
-  r.report.attempts.back() += ", " + std::to_string(applications_ - before) + " F* products";
+  const long before = applications_, columns_before = block_columns_;
+  r.report = solve_local(r.local_q);
+  r.report.attempts.back() += ", " + std::to_string(applications_ - before) + " F* products, "
+                              + std::to_string(block_columns_ - columns_before)
+                              + " F* columns in blocks";
   if (!r.report.converged)
     throw ConvergenceError("flexcontact: increment did not converge; best residual "
                                + detail::exp3(r.report.residual) + " (tolerance "
-                               + detail::exp3(options_.tolerance)
-                               + ") from operator (contact_operator='factor') after "
+                               + detail::exp3(options_.tolerance) + ") from " + r.report.solver
+                               + " (contact_operator='factor') after "
                                + std::to_string(r.report.iterations) + " iterations",
                            r.report);
   r.lambda = r.report.lambda;

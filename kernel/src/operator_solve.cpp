@@ -6,7 +6,10 @@
 
 #include "flexcontact/operator_contact.hpp"
 #include "flexcontact/residual.hpp"
+#include "flexcontact/solvers.hpp"
+#include "message_numbers.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -56,11 +59,73 @@ std::vector<PairState> states_of(const Vector& lambda, const Vector& u,
   return s;
 }
 
-std::string sci(double v)
+/// @brief W_AA from the held columns, symmetrised: each column is a separate solve, so W's
+/// symmetry holds only to rounding, and the dense chain expects a symmetric W.
+Matrix restricted_W(const PairColumns& c, const std::vector<int>& A, int d)
 {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
+  const Eigen::Index n = static_cast<Eigen::Index>(A.size()) * d;
+  Matrix WA(n, n);
+  for (std::size_t b = 0; b < A.size(); ++b)
+  {
+    const Eigen::Index col = static_cast<Eigen::Index>(c.slot[static_cast<std::size_t>(A[b])]) * d;
+    for (std::size_t a = 0; a < A.size(); ++a)
+      WA.block(static_cast<Eigen::Index>(a) * d, static_cast<Eigen::Index>(b) * d, d, d)
+          = c.columns.block(static_cast<Eigen::Index>(A[a]) * d, col, d, d);
+  }
+  return 0.5 * (WA + WA.transpose());
+}
+
+/// @brief u = W λ + q on every pair, λ nonzero only on the set A (its columns are held).
+Vector full_u(const PairColumns& c, const std::vector<int>& A, const Vector& lamA,
+              const Eigen::Ref<const Vector>& q, int d)
+{
+  Vector u = q;
+  for (std::size_t b = 0; b < A.size(); ++b)
+    u.noalias() += c.columns.middleCols(
+                       static_cast<Eigen::Index>(c.slot[static_cast<std::size_t>(A[b])]) * d, d)
+                   * lamA.segment(static_cast<Eigen::Index>(b) * d, d);
+  return u;
+}
+
+/// @brief The pairs that start the working set: those penetrating under q alone, and those
+/// that carried a force in λ0 (their columns give u at the warm start).
+std::vector<int> initial_set(const Eigen::Ref<const Vector>& q, const Vector& lam, int d)
+{
+  std::vector<int> A;
+  for (Eigen::Index k = 0; k < q.size() / d; ++k)
+    if (q[k * d] < 0.0 || lam[k * d] > 0.0)
+      A.push_back(static_cast<int>(k));
+  return A;
+}
+
+/// @brief The problem restricted to the set A, from the full λ and states.
+struct Restricted
+{
+  Matrix W;
+  Vector q, mu, lambda;
+  std::vector<PairState> states;
+};
+
+Restricted restrict_to(const PairColumns& c, const std::vector<int>& A, int d,
+                       const Eigen::Ref<const Vector>& q, const Eigen::Ref<const Vector>& mu,
+                       const Vector& lam, const std::vector<PairState>& states0)
+{
+  Restricted r;
+  r.W = restricted_W(c, A, d);
+  const Eigen::Index n = static_cast<Eigen::Index>(A.size()) * d;
+  r.q.resize(n);
+  r.lambda.resize(n);
+  r.mu.resize(static_cast<Eigen::Index>(A.size()));
+  for (std::size_t a = 0; a < A.size(); ++a)
+  {
+    const Eigen::Index i = static_cast<Eigen::Index>(a) * d, k = A[a] * d;
+    r.q.segment(i, d) = q.segment(k, d);
+    r.lambda.segment(i, d) = lam.segment(k, d);
+    r.mu[static_cast<Eigen::Index>(a)] = mu[A[a]];
+    if (states0.size() * d == static_cast<std::size_t>(q.size()))
+      r.states.push_back(states0[static_cast<std::size_t>(A[a])]);
+  }
+  return r;
 }
 } // namespace
 
@@ -173,8 +238,96 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
   best.converged = best.residual < opt.tolerance;
   best.states = states_of(best.lambda, best.u, q, dim);
   best.attempts.push_back("operator: " + std::to_string(it) + " iterations, "
-                          + std::to_string(restarts) + " restarts, residual " + sci(best.residual)
+                          + std::to_string(restarts) + " restarts, residual " + detail::exp3(best.residual)
                           + (best.converged ? " (converged)" : " (not converged)"));
   return best;
+}
+
+SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchColumns& fetch,
+                              const Eigen::Ref<const Vector>& q,
+                              const Eigen::Ref<const Vector>& mu,
+                              const Eigen::Ref<const Vector>& lambda0,
+                              const std::vector<PairState>& states0, const SolverOptions& opt,
+                              const SameOnAllRanks& same)
+{
+  const Eigen::Index n = q.size();
+  const int m = static_cast<int>(n / dim);
+  SolveReport out;
+  out.solver = "working_set";
+  Vector lam = lambda0.size() == n ? Vector(lambda0) : Vector::Zero(n);
+  std::vector<int> A = initial_set(q, lam, dim);
+  std::vector<char> in(static_cast<std::size_t>(m), 0);
+  for (int k : A)
+    in[static_cast<std::size_t>(k)] = 1;
+  out.lambda = Vector::Zero(n);
+  for (int k : A) // λ0 outside the set has no columns to act through: dropped
+    out.lambda.segment(k * dim, dim) = lam.segment(k * dim, dim);
+  const int max_rounds = 50;
+  int inner = 0;
+  for (int round = 1; round <= max_rounds; ++round)
+  {
+    if (A.empty())
+    {
+      // Nothing penetrates and nothing carried a force: λ = 0 is the answer.
+      out.u = q;
+      out.residual = 0.0;
+      out.converged = true;
+      out.states.assign(static_cast<std::size_t>(m), PairState::open);
+      out.attempts.push_back("working_set: no pair penetrates (converged)");
+      return out;
+    }
+    std::sort(A.begin(), A.end());
+    if (!fetch(A))
+    {
+      out.attempts.push_back("working_set: " + std::to_string(A.size())
+                             + " pairs pass the memory allowed for W's columns");
+      return out;
+    }
+    const Restricted r = restrict_to(columns, A, dim, q, mu, out.lambda, states0);
+    const SolveReport rep = solve(ProblemView{dim, r.W, r.q, r.mu}, r.lambda, r.states, opt);
+    inner += rep.iterations;
+    if (same) // the chain stops on a wall-clock budget: all ranks must agree on its outcome
+      same(rep.converged ? static_cast<long>(A.size()) : -1L);
+    out.lambda.setZero();
+    for (std::size_t a = 0; a < A.size(); ++a)
+      out.lambda.segment(A[a] * dim, dim) = rep.lambda.segment(static_cast<Eigen::Index>(a) * dim, dim);
+    out.iterations = round;
+    if (!rep.converged)
+    {
+      out.residual = rep.residual;
+      out.attempts.push_back("working_set: round " + std::to_string(round) + ", "
+                             + std::to_string(A.size()) + " pairs: the chain did not converge ("
+                             + (rep.attempts.empty() ? rep.solver : rep.attempts.back()) + ")");
+      return out;
+    }
+    Vector u = full_u(columns, A, rep.lambda, q, dim);
+    for (std::size_t a = 0; a < A.size(); ++a) // the restricted solve's own u: its residual
+      u.segment(A[a] * dim, dim) = rep.u.segment(static_cast<Eigen::Index>(a) * dim, dim);
+    const std::size_t before = A.size();
+    for (int k = 0; k < m; ++k)
+      if (!in[static_cast<std::size_t>(k)] && u[k * dim] < 0.0)
+      {
+        in[static_cast<std::size_t>(k)] = 1;
+        A.push_back(k);
+      }
+    if (same)
+      same(static_cast<long>(A.size()));
+    if (A.size() == before)
+    {
+      out.u = std::move(u);
+      out.residual = rep.residual; // bounds the whole problem's: see the header
+      out.converged = true;
+      out.states = states_of(out.lambda, out.u, q, dim);
+      out.attempts.push_back("working_set: " + std::to_string(round) + " rounds, "
+                             + std::to_string(A.size()) + " of " + std::to_string(m)
+                             + " pairs, " + rep.solver + " " + std::to_string(inner)
+                             + " iterations in all, residual " + detail::exp3(rep.residual)
+                             + " (converged)");
+      return out;
+    }
+  }
+  out.attempts.push_back("working_set: still growing after " + std::to_string(max_rounds)
+                         + " rounds (" + std::to_string(A.size()) + " pairs)");
+  return out;
 }
 } // namespace flexcontact

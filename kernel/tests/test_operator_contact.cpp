@@ -47,7 +47,16 @@ Row row_of_pairs(int m, int dim, double mu)
   return r;
 }
 
-void compare(int dim, double mu)
+/// How OperatorContact solves: the matrix-free iteration only, the working set of W's
+/// columns, or the working set with room for one pair's columns (so that it falls back).
+enum class Mode
+{
+  iteration,
+  working_set,
+  working_set_too_small
+};
+
+void compare(int dim, double mu, Mode mode = Mode::iteration)
 {
   const int m = 12;
   const Row row = row_of_pairs(m, dim, mu);
@@ -57,6 +66,10 @@ void compare(int dim, double mu)
   CondensedContact dense(dim, F, row.X, row.pairs, row.mu, {}, opt);
   OperatorContact op(dim, [&F](const Vector& r) { return Vector(F * r); }, row.X, row.pairs,
                      row.mu, {}, opt);
+  const double one_pair = 8.0 * m * dim * dim;
+  if (mode != Mode::iteration)
+    op.use_working_set([&F](const Matrix& R) { return Matrix(F * R); },
+                       mode == Mode::working_set ? 1e9 : one_pair);
   // Push the slaves down and sideways in two increments (the second slides further).
   for (int inc = 1; inc <= 2; ++inc)
   {
@@ -79,6 +92,14 @@ void compare(int dim, double mu)
     const ProblemView view{dim, dense.W(), a.local_q, row.mu};
     EXPECT_EQ(check_laws(view, b.lambda, 1e-7), "") << "increment " << inc;
     EXPECT_GT(b.report.iterations, 0);
+    EXPECT_EQ(b.report.solver, mode == Mode::working_set ? "working_set" : "operator");
+    if (mode == Mode::working_set)
+    {
+      // Columns only of pairs that penetrated at some point, and no F* product alone.
+      EXPECT_GT(op.cached_pairs(), 0);
+      EXPECT_LE(op.cached_pairs(), m);
+      EXPECT_EQ(op.applications(), 0);
+    }
   }
 }
 } // namespace
@@ -86,6 +107,37 @@ void compare(int dim, double mu)
 TEST(OperatorContact, MatchesDenseFrictionless2D) { compare(2, 0.0); }
 TEST(OperatorContact, MatchesDenseFrictional2D) { compare(2, 0.3); }
 TEST(OperatorContact, MatchesDenseFrictional3D) { compare(3, 0.3); }
+TEST(OperatorContact, WorkingSetMatchesDenseFrictionless2D) { compare(2, 0.0, Mode::working_set); }
+TEST(OperatorContact, WorkingSetMatchesDenseFrictional2D) { compare(2, 0.3, Mode::working_set); }
+TEST(OperatorContact, WorkingSetMatchesDenseFrictional3D) { compare(3, 0.3, Mode::working_set); }
+TEST(OperatorContact, WorkingSetPastItsMemoryFallsBack)
+{
+  compare(2, 0.3, Mode::working_set_too_small);
+}
+
+TEST(OperatorContact, ColumnsOfWAreTheDenseOnes)
+{
+  // W[:, pairs] by one block product equals the columns of the dense W = B F* Bᵀ.
+  const int m = 7, dim = 3;
+  const Row row = row_of_pairs(m, dim, 0.2);
+  const Matrix F = random_spd(2 * m * dim, 30.0, 11, 1e-3);
+  CondensedContact dense(dim, F, row.X, row.pairs, row.mu);
+  OperatorContact op(dim, [&F](const Vector& r) { return Vector(F * r); }, row.X, row.pairs,
+                     row.mu);
+  op.use_working_set([&F](const Matrix& R) { return Matrix(F * R); }, 1e9);
+  const std::vector<int> some{5, 1, 3};
+  const Matrix cols = op.W_columns(some);
+  ASSERT_EQ(cols.rows(), m * dim);
+  ASSERT_EQ(cols.cols(), 3 * dim);
+  for (std::size_t a = 0; a < some.size(); ++a)
+    EXPECT_LT((cols.middleCols(static_cast<Eigen::Index>(a) * dim, dim)
+               - dense.W().middleCols(some[a] * dim, dim))
+                  .norm(),
+              1e-12 * dense.W().norm());
+  EXPECT_EQ(op.block_products(), 1);
+  EXPECT_EQ(op.block_columns(), 3 * dim);
+  EXPECT_THROW(op.W_columns({m}), std::invalid_argument);
+}
 
 TEST(OperatorContact, NotConvergedIsAConvergenceError)
 {

@@ -53,16 +53,7 @@ class Condensation:
         self.comm = comm
         root = comm.rank == 0
         self.pairs = pairs
-        # Rigid targets' reference nodes (last) have no PETSc DOFs: held, zero flexibility.
-        n_virtual = getattr(pairs, "n_virtual", 0) if root else 0
-        real = pairs.dofs[:pairs.dofs.shape[0] - n_virtual] if root else None
-        self.dofs = (real.reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
-        self.n_virtual_dofs = n_virtual * dim
-        is_from = PETSc.IS().createGeneral(self.dofs.astype(PETSc.IntType), comm=comm)
-        self._seq = PETSc.Vec().createSeq(self.dofs.size, comm=PETSc.COMM_SELF)
-        is_to = PETSc.IS().createStride(self.dofs.size, 0, 1, comm=PETSc.COMM_SELF)
-        self._scatter = PETSc.Scatter().create(K.createVecLeft(), is_from, self._seq, is_to)
-        self._template = K
+        self._contact_scatter(K, pairs, dim)
         constrained = self._constrained_mask(K, bcs)
 
         # Before MUMPS allocates the Schur complement (memory.py).
@@ -87,6 +78,21 @@ class Condensation:
             self.contact = build(dim, F, pairs.x, kernel_pairs(pairs), mu, constrained, options)
             self.timings["delassus_s"] = time.perf_counter() - t0
             self._operators()
+
+    def _contact_scatter(self, K: PETSc.Mat, pairs, dim: int) -> None:
+        """The contact DOFs (rank 0's list, empty elsewhere), the number of virtual ones
+        (rank 0) and the scatter of their values from a distributed vector to rank 0."""
+        root = self.comm.rank == 0
+        # Rigid targets' reference nodes (last) have no PETSc DOFs: held, zero flexibility.
+        n_virtual = getattr(pairs, "n_virtual", 0) if root else 0
+        real = pairs.dofs[:pairs.dofs.shape[0] - n_virtual] if root else None
+        self.dofs = (real.reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
+        self.n_virtual_dofs = n_virtual * dim
+        is_from = PETSc.IS().createGeneral(self.dofs.astype(PETSc.IntType), comm=self.comm)
+        self._seq = PETSc.Vec().createSeq(self.dofs.size, comm=PETSc.COMM_SELF)
+        is_to = PETSc.IS().createStride(self.dofs.size, 0, 1, comm=PETSc.COMM_SELF)
+        self._scatter = PETSc.Scatter().create(K.createVecLeft(), is_from, self._seq, is_to)
+        self._template = K
 
     def _operators(self):
         c = self.contact

@@ -1,12 +1,13 @@
 """The condensed contact problem without a dense W: ``ContactProblem(contact_operator="factor")``.
 
-One plain MUMPS factorization of K (no Schur complement, no F*); W x = B (K⁻¹ Bᵀ x)_c is
-applied through that factor, one back-substitution per product, and the local problem is
-solved by an accelerated projected fixed point that needs only W·x (kernel's
-operator_contact.hpp). Memory is the factor's plus O(n_c + m·d); each increment costs one
-back-substitution per iteration of the local solver (a few hundred), against the dense
-path's set-up of n_c solves and (m·d)² storage. bench/large_contact.py measures the
-crossover; docs/large_contact.md says when to use which.
+One plain MUMPS factorization of K (no Schur complement, no F*). The local problem is solved
+on a working set of pairs (kernel's operator_contact.hpp: solve_working_set): W's columns of
+the pairs that come into contact only, computed through that factor by blocks of
+right-hand sides and kept across increments, the set grown until no pair outside it
+penetrates. Memory is the factor's plus 8·(m·d)·(d·pairs in the set) bytes, capped by
+memory.working_set_bytes(); past the cap, an accelerated projected fixed point that needs
+only W·x (one back-substitution per iteration, a few hundred) takes over.
+bench/large_contact.py measures the crossover; docs/large_contact.md says when to use which.
 
 In parallel every rank holds the kernel object and runs the same deterministic iteration on
 replicated contact vectors; each product is a collective MatSolve.
@@ -23,6 +24,7 @@ from . import _cpp, compat
 from ._cpp import ConvergenceError
 from .assembly import assemble_load
 from .condensation import Condensation
+from .memory import working_set_bytes
 from .mpi import raise_on_every_rank
 from .postprocess import IncrementResult, record_increment
 
@@ -62,15 +64,9 @@ class FactorCondensation(Condensation):
         self.comm = comm
         root = comm.rank == 0
         self.pairs = pairs
-        n_virtual = getattr(pairs, "n_virtual", 0) if root else 0
-        real = pairs.dofs[:pairs.dofs.shape[0] - n_virtual] if root else None
-        self.dofs = (real.reshape(-1).astype(np.int64) if root else np.zeros(0, np.int64))
-        self.n_virtual_dofs = comm.bcast(n_virtual * dim, root=0)
-        is_from = PETSc.IS().createGeneral(self.dofs.astype(PETSc.IntType), comm=comm)
-        self._seq = PETSc.Vec().createSeq(self.dofs.size, comm=PETSc.COMM_SELF)
-        is_to = PETSc.IS().createStride(self.dofs.size, 0, 1, comm=PETSc.COMM_SELF)
-        self._scatter = PETSc.Scatter().create(K.createVecLeft(), is_from, self._seq, is_to)
-        self._template = K
+        self._contact_scatter(K, pairs, dim)
+        # Every rank builds the kernel object: each needs the number of virtual DOFs.
+        self.n_virtual_dofs = comm.bcast(self.n_virtual_dofs, root=0)
         constrained = self._constrained_mask(K, bcs)
         if root and self.n_virtual_dofs:
             constrained = np.concatenate([constrained, np.ones(self.n_virtual_dofs, bool)])
@@ -86,14 +82,16 @@ class FactorCondensation(Condensation):
         self.factorizations = 1
         self.n_contact_dofs = comm.bcast(self.dofs.size if root else None, root=0)
 
-        dofs, x, arrays, mu, constrained = comm.bcast(
-            (self.dofs, np.asarray(pairs.x), _pair_arrays(pairs), np.asarray(mu), constrained)
-            if root else None, root=0)
+        # Rank 0's memory for the working set: every rank must take the same branches.
+        dofs, x, arrays, mu, constrained, self.working_set_bytes = comm.bcast(
+            (self.dofs, np.asarray(pairs.x), _pair_arrays(pairs), np.asarray(mu), constrained,
+             working_set_bytes()) if root else None, root=0)
         t0 = time.perf_counter()
         self.contact = _cpp.FactorContact(dim, self.factor.handle, K.handle, dofs,
                                           self.n_virtual_dofs, x,
-                                          _kernel_pairs(arrays), mu, constrained, options)
-        self.timings["delassus_s"] = time.perf_counter() - t0  # the ‖W‖ and ρ estimates
+                                          _kernel_pairs(arrays), mu, constrained, options,
+                                          self.working_set_bytes)
+        self.timings["delassus_s"] = time.perf_counter() - t0
         self.W = None
         self._operators()
 

@@ -80,8 +80,9 @@ def check_dense_memory(n_contact_dofs: int, pairs: int, dim: int,
             f"(F* and the Schur complement on n_c = {n_contact_dofs} contact DOFs: "
             f"{FSTAR_COPIES} x 8·n_c² bytes; W of m = {pairs} pairs: {W_COPIES} x 8·(m·d)² "
             f"bytes, d = {dim}) but only {avail / 1e9:.2f} GB are available; use "
-            "ContactProblem(..., contact_operator=\"factor\"), which applies W through the "
-            "factor of K without forming F* or W, or tag a smaller candidate contact zone")
+            "ContactProblem(..., contact_operator=\"factor\"), which works through the "
+            "factor of K without forming F* or the whole W, or tag a smaller candidate contact "
+            "zone")
     raise ContactMemoryError(text, needed, avail, n_contact_dofs, pairs)
 
 
@@ -96,3 +97,26 @@ def check_dense_memory_collective(comm, n_contact_dofs: Optional[int], pairs: Op
         except ContactMemoryError as e:
             error = e
     raise_on_every_rank(comm, error)
+
+
+ENV_WORKING_SET = "FLEXCONTACT_WORKING_SET_GB"
+# Of the memory available, what the factor path may hold of W's columns for the pairs in
+# contact (operator_contact.hpp: solve_working_set); the rest is left to the factor's solves.
+WORKING_SET_SHARE = 0.25
+
+
+def working_set_bytes() -> float:
+    """Memory for the factor path's columns of W (bytes): FLEXCONTACT_WORKING_SET_GB when
+    set (0 turns the working set off: the matrix-free iteration only), otherwise a quarter
+    of available_bytes()."""
+    env = os.environ.get(ENV_WORKING_SET)
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            raise ValueError(f"{ENV_WORKING_SET}={env!r}; it must be a number of GB") from None
+        if not value >= 0:
+            raise ValueError(f"{ENV_WORKING_SET}={env!r}; it must be ≥ 0 GB")
+        return value * 1e9
+    avail = available_bytes()
+    return WORKING_SET_SHARE * avail if avail < float("inf") else 1e12

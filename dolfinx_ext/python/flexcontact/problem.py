@@ -180,9 +180,11 @@ class ContactProblem:
         and small slips).
     contact_operator : "dense" (default): F* and W = B F* Bᵀ formed densely (8·n_c² and
         8·(m·d)² bytes on rank 0; a ContactMemoryError before any allocation when they would
-        not fit), the local solver chain on W. "factor": one plain factorization, W applied
-        through it (one back-substitution per product), an iterative local solver on W·x:
-        O(n_c) memory for large contact sets, slower per increment (docs/large_contact.md).
+        not fit), the local solver chain on W. "factor": one plain factorization, F* never
+        formed; the local problem solved on a working set of W's columns (the pairs that
+        come into contact, computed through the factor by blocks of right-hand sides and
+        kept across increments), or past its memory cap by an iteration on W·x: memory
+        O(n_c·pairs in contact) for large candidate zones (docs/large_contact.md).
 
     On rank 0, ``contact`` is the kernel's condensed problem and ``B``, ``W``, ``x0``,
     ``frames`` its operators; ``local_problem`` is the last increment's {dim, W, q, mu}.

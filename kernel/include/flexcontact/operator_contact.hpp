@@ -21,6 +21,27 @@ namespace flexcontact
 /// @brief y = A x for a symmetric positive semi-definite A.
 using LinearOperator = std::function<Vector(const Vector&)>;
 
+/// @brief Y = A X for the columns of X at once (for F*: one multi-right-hand-side
+/// back-substitution, much cheaper per column than as many single solves).
+using BlockOperator = std::function<Matrix(const Matrix&)>;
+
+/// @brief Columns of W for some pairs, kept across increments: W[:, pair k] is the m·d × d
+/// block `slot[k]` of `columns`.
+struct PairColumns
+{
+  Matrix columns;         ///< m·d × (d · cached pairs)
+  std::vector<int> slot;  ///< per pair: its block in `columns`, or -1
+  std::vector<int> order; ///< the cached pairs, in block order
+};
+
+/// @brief Makes W's columns of `pairs` available in the PairColumns it was given; false if
+/// they would pass the memory allowed (nothing fetched then).
+using FetchColumns = std::function<bool(const std::vector<int>& pairs)>;
+
+/// @brief Checks that every rank running the same iteration reached the same value, and
+/// throws on every rank if not (collective); empty in serial.
+using SameOnAllRanks = std::function<void(long value)>;
+
 /// @brief Scales of a matrix-free local problem: a step from ‖W‖ and the natural-map ρ.
 struct OperatorScales
 {
@@ -45,11 +66,34 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
                            const Eigen::Ref<const Vector>& q, const Eigen::Ref<const Vector>& mu,
                            const Eigen::Ref<const Vector>& lambda0, const SolverOptions& opt);
 
+/// @brief The local problem on a working set of pairs, W never formed beyond the set's
+/// columns: start from the pairs that penetrate under q (q_n < 0) or carried a force in λ0;
+/// solve the problem restricted to the set with the dense solver chain (solvers.hpp: solve,
+/// on W_AA, from λ0 and states0); from W[:, A] λ_A + q find the pairs outside the set that
+/// penetrate, add them and repeat. When none does, λ (zero outside the set) solves the whole
+/// problem: outside the set λ = 0 with u_n ≥ 0 is exactly the De Saxcé map's fixed point, so
+/// the whole natural-map residual (any ρ outside the set) is at most the restricted one,
+/// which is reported. Each round fetches only the new pairs' columns (one block product).
+/// Returns converged=false (its last λ, and a line in `attempts`) if the set passes the
+/// memory `fetch` allows, the chain fails, or 50 rounds pass; never throws on that. After
+/// each round `same` (if given) checks that every rank took the same branch with the same
+/// set: the chain has a wall-clock budget, and ranks must not part ways in collective solves.
+SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchColumns& fetch,
+                              const Eigen::Ref<const Vector>& q,
+                              const Eigen::Ref<const Vector>& mu,
+                              const Eigen::Ref<const Vector>& lambda0,
+                              const std::vector<PairState>& states0, const SolverOptions& opt,
+                              const SameOnAllRanks& same = {});
+
 /// @brief Pairs, B, x0 and the incremental driver of CondensedContact, with F* an operator.
 ///
 /// The same increment as CondensedContact::step (slip measured from the last increment's
 /// tangential gap, λ and states carried over as warm start, r_c = Bᵀ λ zero on constrained
-/// DOFs), solved by solve_operator. No W, no F* is ever formed.
+/// DOFs). With a block operator (use_working_set) it is solved by solve_working_set on the
+/// columns of W of the pairs that come into contact, computed by blocks of right-hand sides
+/// and kept across increments (until the pairs change) within a memory cap; otherwise, or
+/// when that fails, by solve_operator from its best λ. F* is never formed; W only in the
+/// columns of the working set.
 class OperatorContact
 {
 public:
@@ -71,19 +115,38 @@ public:
   /// @brief W x = B F*(Bᵀ x), constrained contact DOFs neither loaded nor moving.
   Vector apply_W(const Vector& x) const;
 
+  /// @brief Solve increments on a working set of W's columns (solve_working_set), computed
+  /// through `block` (F* on many columns at once) and held within `max_bytes` (8 bytes per
+  /// entry of the m·d × d·pairs columns); max_bytes ≤ 0 turns it off.
+  void use_working_set(BlockOperator block, double max_bytes, SameOnAllRanks same = {});
+
+  /// @brief W[:, pairs] (m·d × d·|pairs|) through one block product (constrained DOFs as in
+  /// apply_W).
+  Matrix W_columns(const std::vector<int>& pairs) const;
+
   const Eigen::SparseMatrix<double>& B() const { return B_; } ///< m·d × n_c
   const Vector& x0() const { return x0_; }
   const Vector& mu() const { return mu_; }
   const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
+  /// @brief The step and ρ estimates of solve_operator, computed when it first runs for the
+  /// current pairs (zero until then).
   const OperatorScales& scales() const { return scales_; }
   /// @brief F* products since construction (each one back-substitution for the caller).
   long applications() const { return applications_; }
+  /// @brief Columns F* was applied to in block products, and the block products, since
+  /// construction.
+  long block_columns() const { return block_columns_; }
+  long block_products() const { return block_products_; }
+  /// @brief Pairs whose columns of W are held now.
+  int cached_pairs() const { return static_cast<int>(columns_.order.size()); }
   int dim() const { return dim_; }
   int pairs() const { return static_cast<int>(pairs_.size()); }
   int contact_dofs() const { return static_cast<int>(X_.rows()) * dim_; }
 
 private:
   Vector flex(Vector r) const;
+  bool fetch_columns(const std::vector<int>& pairs);
+  SolveReport solve_local(const Vector& q);
 
   int dim_;
   LinearOperator F_;
@@ -99,5 +162,10 @@ private:
   std::vector<PairState> states_;
   Vector up_c_, reaction_;         ///< of the last increment, for u_c at re-pairing
   mutable long applications_ = 0;
+  BlockOperator block_;
+  double max_bytes_ = 0.0;
+  SameOnAllRanks same_;
+  PairColumns columns_;
+  mutable long block_columns_ = 0, block_products_ = 0;
 };
 } // namespace flexcontact
