@@ -61,8 +61,32 @@ def _box_record(dim, n):
            "condensed": bc, "u_c": uc_all, "expanded": gather(xe),
            "method": info["method"], "ordering": info["ordering"],
            "mumps_ordering": info["mumps_ordering"], "factor_type": type(factor).__name__,
-           "has_condense": bool(factor.has_condense)}
+           "has_condense": bool(factor.has_condense),
+           "distributed_io": bool(factor.distributed_io)}
+    # A second right-hand side through the solution scatter built by the first expansion
+    b2_all = np.random.default_rng(20 + dim).standard_normal(N)
+    uc2_all = np.random.default_rng(30 + dim).standard_normal(n_c)
+    out.update({f"{k}2": v for k, v in _condense_expand(factor, K, b2_all, uc2_all).items()})
+    # The same with b gathered on rank 0 and the solution scattered from it
+    factor.distributed_io = False
+    out.update({f"{k}_central": v for k, v in _condense_expand(factor, K, b_all, uc_all).items()})
+    out["io_refusal"] = int(factor.io_refusal)
     factor.destroy()
+    return out
+
+
+def _condense_expand(factor, K, b_all, uc_all) -> dict:
+    """condense(b), expand(u_c) and solve(b) with the factor as it is set (global arrays)."""
+    comm = MPI.COMM_WORLD
+    r0, r1 = K.getOwnershipRange()
+    b, x, xe = K.createVecLeft(), K.createVecRight(), K.createVecRight()
+    b.setArray(b_all[r0:r1])
+    bc = factor.condense(b)
+    factor.expand(uc_all if comm.rank == 0 else None, xe)
+    factor.solve(b, x)
+    out = {"b": b_all, "u_c": uc_all, "condensed": bc, "expanded": gather(xe), "x": gather(x)}
+    for v in (b, x, xe):
+        v.destroy()
     return out
 
 
@@ -174,22 +198,42 @@ def test_two_ranks_schur_flexibility_equals_petsc_serial(two_ranks, dim):
     assert rel(par[f"x_{dim}"], x.getArray()) < ROUNDOFF
 
 
-@pytest.mark.mpi
-@pytest.mark.parametrize("dim", [d for d, _ in BOXES])
-def test_two_ranks_condense_and_expand(two_ranks, dim):
-    par = two_ranks[0]
-    Kd, dofs, b = par[f"K_{dim}"], par[f"dofs_{dim}"], par[f"b_{dim}"]
+def _dense_condense_expand(Kd, dofs, b, uc):
+    """b̃_c = b_c − K_ci K_ii⁻¹ b_i (in the order of the contact DOFs given) and the
+    expansion of u_c: x_c = u_c, x_i = K_ii⁻¹ (b_i − K_ic u_c), by dense algebra."""
     inner = np.setdiff1d(np.arange(Kd.shape[0]), dofs)
     Kii, Kic = Kd[np.ix_(inner, inner)], Kd[np.ix_(inner, dofs)]
-    # b̃_c = b_c − K_ci K_ii⁻¹ b_i, in the order of the contact DOFs given
-    expected = b[dofs] - Kic.T @ np.linalg.solve(Kii, b[inner])
-    assert rel(par[f"condensed_{dim}"], expected) < ROUNDOFF
-    # the expansion of u_c: x_c = u_c, x_i = K_ii⁻¹ (b_i − K_ic u_c)
-    uc = par[f"u_c_{dim}"]
+    condensed = b[dofs] - Kic.T @ np.linalg.solve(Kii, b[inner])
     x = np.empty(Kd.shape[0])
     x[dofs] = uc
     x[inner] = np.linalg.solve(Kii, b[inner] - Kic @ uc)
-    assert rel(par[f"expanded_{dim}"], x) < ROUNDOFF
+    return condensed, x
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("suffix", ["", "2", "_central"])
+@pytest.mark.parametrize("dim", [d for d, _ in BOXES])
+def test_two_ranks_condense_and_expand(two_ranks, dim, suffix):
+    """Distributed right-hand side and solution (the default; "2": a second right-hand side
+    through the same solution scatter) and centralised ones ("_central")."""
+    par = two_ranks[0]
+    assert par[f"distributed_io_{dim}"] and par[f"io_refusal_{dim}"] == 0
+    Kd, dofs = par[f"K_{dim}"], par[f"dofs_{dim}"]
+    b, uc = par[f"b{suffix}_{dim}"], par[f"u_c{suffix}_{dim}"]
+    condensed, x = _dense_condense_expand(Kd, dofs, b, uc)
+    assert rel(par[f"condensed{suffix}_{dim}"], condensed) < ROUNDOFF
+    assert rel(par[f"expanded{suffix}_{dim}"], x) < ROUNDOFF
+    assert rel(par[f"x{suffix}_{dim}"], np.linalg.solve(Kd, b)) < ROUNDOFF
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("dim", [d for d, _ in BOXES])
+def test_two_ranks_distributed_io_equals_centralised(two_ranks, dim):
+    """The same factor gives the same numbers whether b and the solution pass through rank 0
+    or stay on their ranks: only the order of a few sums may differ."""
+    par = two_ranks[0]
+    for k in ("condensed", "expanded", "x"):
+        assert rel(par[f"{k}_{dim}"], par[f"{k}_central_{dim}"]) < 1e-12, k
 
 
 @pytest.mark.mpi

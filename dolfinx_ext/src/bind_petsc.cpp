@@ -167,6 +167,29 @@ void bind_distributed_schur(py::module& m)
           py::arg("u_c"), py::arg("x"),
           "x = the solution whose contact values are u_c (rank 0), for the right-hand side "
           "of the last condense().")
+      .def_property(
+          "distributed_io", &DistributedSchur::distributed_io,
+          &DistributedSchur::set_distributed_io,
+          "True (default): b handed to MUMPS by each rank's rows and the solution returned "
+          "to them (ICNTL(20) = 10, ICNTL(21) = 1); False: b gathered on rank 0 and the "
+          "solution scattered from it (ICNTL(20) = ICNTL(21) = 0). Set it on every rank.")
+      .def_property_readonly("io_refusal", &DistributedSchur::io_refusal,
+                             "MUMPS's INFOG(1) if it refused the distributed right-hand side "
+                             "or solution (the centralised ones are then used), else 0")
+      .def_property_readonly(
+          "last_times",
+          [](const DistributedSchur& f)
+          {
+            const auto& t = f.last_times();
+            py::dict d;
+            d["gather_s"] = t.gather_s;
+            d["condense_s"] = t.condense_s;
+            d["expand_s"] = t.expand_s;
+            d["scatter_s"] = t.scatter_s;
+            return d;
+          },
+          "This rank's wall times (s) of the last condense and expand: b to MUMPS, MUMPS's "
+          "condensation, its expansion, the solution into x")
       .def("destroy", &DistributedSchur::release,
            "Free the MUMPS instance now (otherwise when the object goes).");
 }

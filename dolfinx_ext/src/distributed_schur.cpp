@@ -64,13 +64,13 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
     throw std::invalid_argument("K has " + std::to_string(n_) + " rows: more than MUMPS's "
                                 "32-bit indices hold");
   n_c_ = static_cast<int>(schur.size());
+  schur_rows_ = schur;
   local_upper_triplets(K, irn_, jcn_, a_);
-
-  Vec layout = nullptr;
-  err.check(MatCreateVecs(K, nullptr, &layout), "MatCreateVecs");
-  PetscErrorCode ierr = VecScatterCreateToZero(layout, &to_zero_, &host_);
-  VecDestroy(&layout);
-  err.check(ierr, "VecScatterCreateToZero");
+  err.check(MatGetOwnershipRange(K, &rstart_, &rend_), "MatGetOwnershipRange");
+  irhs_loc_.assign(std::max<std::size_t>(rend_ - rstart_, 1), 1); // never a null IRHS_loc
+  for (PetscInt r = rstart_; r < rend_; ++r)
+    irhs_loc_[r - rstart_] = static_cast<int>(r + 1);
+  rhs_loc_.assign(irhs_loc_.size(), 0.0);
 
   id_.job = -1;
   id_.par = 1; // the host works too
@@ -86,8 +86,8 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
     icntl(id_, 4) = 0;
     icntl(id_, 5) = 0;  // assembled
     icntl(id_, 18) = 3; // distributed triplets
-    icntl(id_, 20) = 0; // dense right-hand side on the host
-    icntl(id_, 21) = 0; // solution on the host
+    icntl(id_, 20) = 0; // set per solve (condense_centralised / condense_distributed)
+    icntl(id_, 21) = 0;
     icntl(id_, 24) = 1; // detect null pivots (INFOG(28)) instead of dividing by ~0
     icntl(id_, 28) = 1; // sequential analysis: takes PERM_IN (no ParMETIS/PT-SCOTCH here)
     icntl(id_, 7) = icntl7;
@@ -123,6 +123,7 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
     stats_.analysis_s = MPI_Wtime() - t0;
     stats_.infog7 = infog(id_, 7);
     factorize();
+    allocate_distributed_solution();
   }
   catch (...)
   {
@@ -192,10 +193,15 @@ void DistributedSchur::release()
   {
     VecScatterDestroy(&to_zero_);
     VecDestroy(&host_);
+    VecScatterDestroy(&sol_scatter_);
+    VecDestroy(&sol_seq_);
   }
   std::vector<double>().swap(schur_);
   std::vector<double>().swap(rhs_);
   std::vector<double>().swap(condensed_rhs_);
+  std::vector<double>().swap(rhs_loc_);
+  std::vector<double>().swap(sol_buf_);
+  std::vector<double>().swap(host_rhs_stub_);
 }
 
 const double* DistributedSchur::schur_complement()
@@ -235,11 +241,63 @@ void DistributedSchur::scatter_back(const double* host, Vec x)
   err.check(VecScatterEnd(to_zero_, host_, x, INSERT_VALUES, SCATTER_REVERSE), "VecScatterEnd");
 }
 
+void DistributedSchur::allocate_distributed_solution()
+{
+  PetscErrorScope err;
+  // INFO(23): the rows of the distributed solution this rank receives (the Schur variables
+  // among them: rank 0 sets those from u_c, stored after them).
+  n_sol_loc_ = std::max(id_.info[22], 0);
+  const std::size_t n_loc = std::max(n_sol_loc_, 1); // never a null SOL_loc for MUMPS
+  isol_loc_.assign(n_loc, 0);
+  sol_buf_.assign(n_loc + (rank_ == 0 ? static_cast<std::size_t>(n_c_) : 0), 0.0);
+  err.check(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, static_cast<PetscInt>(sol_buf_.size()),
+                                  sol_buf_.data(), &sol_seq_),
+            "VecCreateSeqWithArray");
+}
+
+void DistributedSchur::set_distributed_io(bool on) { distributed_io_ = on; }
+
+void DistributedSchur::host_reduced_rhs()
+{
+  if (rank_ != 0)
+    return;
+  redrhs_.assign(n_c_, 0.0);
+  id_.redrhs = redrhs_.data();
+  id_.lredrhs = std::max(n_c_, 1);
+}
+
 std::vector<double> DistributedSchur::condense(Vec b)
 {
   if (!alive_)
     throw std::runtime_error("the distributed MUMPS factor was released");
+  times_ = {};
+  if (distributed_io_)
+  {
+    try
+    {
+      condense_distributed(b);
+    }
+    catch (const MumpsError& e)
+    {
+      // MUMPS checks a solve's parameters before any work (INFOG(1) is global: every rank
+      // is here); the factor is intact, so the centralised variant takes over.
+      io_refusal_ = e.infog1;
+      distributed_io_ = false;
+      condense_centralised(b);
+    }
+  }
+  else
+    condense_centralised(b);
+  condensed_ = true;
+  return rank_ == 0 ? redrhs_ : std::vector<double>();
+}
+
+void DistributedSchur::condense_centralised(Vec b)
+{
   PetscErrorScope err;
+  double t0 = MPI_Wtime();
+  if (!to_zero_) // only this variant needs the N values on rank 0
+    err.check(VecScatterCreateToZero(b, &to_zero_, &host_), "VecScatterCreateToZero");
   err.check(VecScatterBegin(to_zero_, b, host_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
   err.check(VecScatterEnd(to_zero_, b, host_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
   if (rank_ == 0)
@@ -248,23 +306,63 @@ std::vector<double> DistributedSchur::condense(Vec b)
     err.check(VecGetArrayRead(host_, &h), "VecGetArrayRead");
     condensed_rhs_.assign(h, h + n_);
     err.check(VecRestoreArrayRead(host_, &h), "VecRestoreArrayRead");
-    redrhs_.assign(n_c_, 0.0);
     id_.rhs = condensed_rhs_.data();
-    id_.redrhs = redrhs_.data();
     id_.lrhs = static_cast<int>(n_);
-    id_.lredrhs = std::max(n_c_, 1);
   }
+  times_.gather_s = MPI_Wtime() - t0;
+  host_reduced_rhs();
+  icntl(id_, 20) = 0; // dense right-hand side on the host
+  icntl(id_, 21) = 0; // solution on the host
   id_.nrhs = 1;
   icntl(id_, 26) = n_c_ > 0 ? 1 : 0;
+  t0 = MPI_Wtime();
   call(3, "condensation");
-  condensed_ = true;
-  return rank_ == 0 ? redrhs_ : std::vector<double>();
+  times_.condense_s = MPI_Wtime() - t0;
+  condensed_distributed_ = false;
+}
+
+void DistributedSchur::condense_distributed(Vec b)
+{
+  PetscErrorScope err;
+  double t0 = MPI_Wtime();
+  PetscInt n_loc = 0;
+  err.check(VecGetLocalSize(b, &n_loc), "VecGetLocalSize");
+  if (n_loc != rend_ - rstart_)
+    throw std::invalid_argument("condense: b has " + std::to_string(n_loc) + " rows on rank "
+                                + std::to_string(rank_) + ", K " + std::to_string(rend_ - rstart_));
+  // A copy: MUMPS keeps RHS_loc's address until the expansion, b may be gone by then.
+  const PetscScalar* v = nullptr;
+  err.check(VecGetArrayRead(b, &v), "VecGetArrayRead");
+  std::copy(v, v + n_loc, rhs_loc_.begin());
+  err.check(VecRestoreArrayRead(b, &v), "VecRestoreArrayRead");
+  times_.gather_s = MPI_Wtime() - t0;
+  host_reduced_rhs();
+  icntl(id_, 20) = 10; // dense right-hand side, each rank its own rows
+  icntl(id_, 21) = 1;  // solution left where MUMPS eliminated it
+  id_.nloc_rhs = static_cast<int>(n_loc);
+  id_.lrhs_loc = std::max(static_cast<int>(n_loc), 1);
+  id_.irhs_loc = irhs_loc_.data();
+  id_.rhs_loc = rhs_loc_.data();
+  id_.lsol_loc = std::max(static_cast<int>(isol_loc_.size()), 1);
+  id_.isol_loc = isol_loc_.data();
+  id_.sol_loc = sol_buf_.data();
+  id_.nrhs = 1;
+  icntl(id_, 26) = n_c_ > 0 ? 1 : 0;
+  t0 = MPI_Wtime();
+  call(3, "condensation (distributed right-hand side)");
+  times_.condense_s = MPI_Wtime() - t0;
+  condensed_distributed_ = true;
 }
 
 void DistributedSchur::expand(std::span<const double> u_c, Vec x)
 {
   if (!condensed_)
     throw std::runtime_error("expand() needs a condense() first");
+  if (condensed_distributed_)
+  {
+    expand_distributed(u_c, x);
+    return;
+  }
   if (rank_ == 0)
   {
     std::copy(u_c.begin(), u_c.end(), redrhs_.begin());
@@ -273,9 +371,89 @@ void DistributedSchur::expand(std::span<const double> u_c, Vec x)
   }
   id_.nrhs = 1;
   icntl(id_, 26) = n_c_ > 0 ? 2 : 0;
+  double t0 = MPI_Wtime();
   if (n_c_ > 0)
     call(3, "expansion");
+  times_.expand_s = MPI_Wtime() - t0;
+  t0 = MPI_Wtime();
   scatter_back(condensed_rhs_.data(), x);
+  times_.scatter_s = MPI_Wtime() - t0;
+}
+
+void DistributedSchur::expand_distributed(std::span<const double> u_c, Vec x)
+{
+  PetscErrorScope err;
+  if (rank_ == 0)
+  {
+    std::copy(u_c.begin(), u_c.end(), redrhs_.begin());
+    id_.redrhs = redrhs_.data();
+    // the Schur rows of x are u_c: set from here, whatever SOL_loc holds for them
+    std::copy(u_c.begin(), u_c.end(), sol_buf_.begin() + static_cast<std::ptrdiff_t>(isol_loc_.size()));
+  }
+  id_.nrhs = 1;
+  if (rank_ == 0)
+  {
+    // MUMPS 5.5's expansion with a distributed solution still needs the host's centralised
+    // RHS array to exist (a null one is a segfault), though it neither reads nor writes it
+    // here (measured: it stays zero); allocated once, never filled.
+    if (host_rhs_stub_.size() != static_cast<std::size_t>(n_))
+      host_rhs_stub_.assign(static_cast<std::size_t>(n_), 0.0);
+    id_.rhs = host_rhs_stub_.data();
+    id_.lrhs = static_cast<int>(n_);
+  }
+  double t0 = MPI_Wtime();
+  if (n_c_ > 0) // else the condensation was the whole solve
+  {
+    icntl(id_, 26) = 2;
+    call(3, "expansion (distributed solution)");
+  }
+  times_.expand_s = MPI_Wtime() - t0;
+  t0 = MPI_Wtime();
+  if (!sol_scatter_) // ISOL_loc is known once MUMPS has returned a solution
+    build_solution_scatter(x);
+  // MUMPS and u_c were written behind the Vec's back: get/restore marks it changed
+  PetscScalar* touched = nullptr;
+  err.check(VecGetArray(sol_seq_, &touched), "VecGetArray");
+  err.check(VecRestoreArray(sol_seq_, &touched), "VecRestoreArray");
+  err.check(VecScatterBegin(sol_scatter_, sol_seq_, x, INSERT_VALUES, SCATTER_FORWARD),
+            "VecScatterBegin");
+  err.check(VecScatterEnd(sol_scatter_, sol_seq_, x, INSERT_VALUES, SCATTER_FORWARD),
+            "VecScatterEnd");
+  times_.scatter_s = MPI_Wtime() - t0;
+}
+
+void DistributedSchur::build_solution_scatter(Vec x)
+{
+  PetscErrorScope err;
+  std::vector<PetscInt> sorted(schur_rows_);
+  std::sort(sorted.begin(), sorted.end());
+  const auto tail = static_cast<PetscInt>(isol_loc_.size()); // rank 0's u_c from there
+  std::vector<PetscInt> from, to;
+  from.reserve(isol_loc_.size() + n_c_), to.reserve(isol_loc_.size() + n_c_);
+  for (PetscInt i = 0; i < n_sol_loc_; ++i)
+  {
+    const PetscInt g = isol_loc_[i] - 1;
+    if (!std::binary_search(sorted.begin(), sorted.end(), g)) // rank 0's u_c sets those
+      from.push_back(i), to.push_back(g);
+  }
+  if (rank_ == 0)
+    for (int k = 0; k < n_c_; ++k)
+      from.push_back(tail + k), to.push_back(schur_rows_[k]);
+  // Every row of x from exactly one place, or x would keep stale values somewhere.
+  long long covered = static_cast<long long>(from.size()), total = 0;
+  MPI_Allreduce(&covered, &total, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+  if (total != static_cast<long long>(n_))
+    throw std::logic_error("MUMPS's distributed solution covers " + std::to_string(total)
+                           + " of " + std::to_string(n_) + " rows");
+  IS is_from = nullptr, is_to = nullptr;
+  err.check(ISCreateGeneral(PETSC_COMM_SELF, static_cast<PetscInt>(from.size()), from.data(),
+                            PETSC_COPY_VALUES, &is_from), "ISCreateGeneral");
+  err.check(ISCreateGeneral(PETSC_COMM_SELF, static_cast<PetscInt>(to.size()), to.data(),
+                            PETSC_COPY_VALUES, &is_to), "ISCreateGeneral");
+  PetscErrorCode ierr = VecScatterCreate(sol_seq_, is_from, x, is_to, &sol_scatter_);
+  ISDestroy(&is_from);
+  ISDestroy(&is_to);
+  err.check(ierr, "VecScatterCreate");
 }
 
 void DistributedSchur::solve(Vec b, Vec x)

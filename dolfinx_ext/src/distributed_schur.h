@@ -11,8 +11,15 @@
 /// computes K*_cc = K_cc − K_ci K_ii⁻¹ K_ic on the host (ICNTL(19) = 1: for a symmetric
 /// matrix its lower triangle by rows), and F* = (K*_cc)⁻¹ is inverted block by block there as
 /// in serial. Solves go through MUMPS's condensation (ICNTL(26) = 1: b̃_c = b_c − K_ci K_ii⁻¹
-/// b_i) and expansion (ICNTL(26) = 2: u from u_c), with u_c = F* b̃_c for a full solve. The
-/// right-hand side and solution are centralised on the host (ICNTL(20) = ICNTL(21) = 0).
+/// b_i) and expansion (ICNTL(26) = 2: u from u_c), with u_c = F* b̃_c for a full solve.
+///
+/// By default the right-hand side and the solution stay distributed (ICNTL(20) = 10: each
+/// rank hands MUMPS its own rows of b; ICNTL(21) = 1: each rank gets back the rows MUMPS
+/// eliminated there, scattered into x by one VecScatter built at the first expansion), so
+/// an increment moves no N-vector through rank 0; only b̃_c and u_c (n_c values) live on
+/// the host. The centralised variant (ICNTL(20) = ICNTL(21) = 0: b gathered on rank 0, the
+/// solution scattered back from it) stays selectable (set_distributed_io) and is taken
+/// automatically if MUMPS refuses the distributed one (its INFOG(1) in io_refusal()).
 
 #include <Eigen/Dense>
 #include <dmumps_c.h>
@@ -36,6 +43,15 @@ struct DistributedFactorStats
   std::int64_t factor_entries = 0; ///< INFOG(29)
   double factor_flops = 0;    ///< RINFOG(3)
   int factor_memory_mb = 0;   ///< INFOG(22)
+};
+
+/// @brief Wall times (s, this rank's) of the last condense() and expand().
+struct DistributedSolveTimes
+{
+  double gather_s = 0;    ///< b to MUMPS: the gather to rank 0, or the copy of the local rows
+  double condense_s = 0;  ///< MUMPS's condensation (job 3, ICNTL(26) = 1)
+  double expand_s = 0;    ///< MUMPS's expansion (job 3, ICNTL(26) = 2)
+  double scatter_s = 0;   ///< the solution into x (from rank 0, or from each rank's rows)
 };
 
 class DistributedSchur
@@ -76,10 +92,25 @@ public:
   /// the last condense(). Collective.
   void expand(std::span<const double> u_c, Vec x);
 
+  /// @brief Distributed (true, the default) or centralised right-hand side and solution;
+  /// the same value on every rank. Takes effect at the next condense().
+  void set_distributed_io(bool on);
+  bool distributed_io() const { return distributed_io_; }
+  /// @brief MUMPS's INFOG(1) if it refused the distributed right-hand side or solution
+  /// (then centralised ones are used), else 0.
+  int io_refusal() const { return io_refusal_; }
+  const DistributedSolveTimes& last_times() const { return times_; }
+
 private:
   void call(int job, const char* phase);
   void factorize();
   void scatter_back(const double* host, Vec x);
+  void condense_centralised(Vec b);
+  void condense_distributed(Vec b);
+  void expand_distributed(std::span<const double> u_c, Vec x);
+  void allocate_distributed_solution();
+  void build_solution_scatter(Vec x);
+  void host_reduced_rhs();
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;
@@ -94,6 +125,22 @@ private:
   VecScatter to_zero_ = nullptr; ///< K's row layout → all on rank 0
   Vec host_ = nullptr;           ///< the N values on rank 0 (0 elsewhere)
   DistributedFactorStats stats_;
+  DistributedSolveTimes times_;
+
+  // distributed right-hand side and solution
+  bool distributed_io_ = true;
+  bool condensed_distributed_ = false; ///< how the last condense() ran
+  int io_refusal_ = 0;
+  PetscInt rstart_ = 0, rend_ = 0;     ///< this rank's rows of K
+  std::vector<PetscInt> schur_rows_;   ///< `schur`, 0-based, every rank
+  std::vector<int> irhs_loc_;          ///< rstart_+1 … rend_ (1-based)
+  std::vector<double> rhs_loc_;        ///< this rank's rows of the last b
+  int n_sol_loc_ = 0;                  ///< INFO(23): the rows MUMPS returns here
+  std::vector<int> isol_loc_;          ///< their global indices (1-based), ≥ 1 entry
+  std::vector<double> sol_buf_;        ///< sol_loc, then u_c on rank 0: sol_seq_'s array
+  std::vector<double> host_rhs_stub_;  ///< rank 0: the N-array MUMPS's expansion needs
+  Vec sol_seq_ = nullptr;
+  VecScatter sol_scatter_ = nullptr;   ///< sol_seq_ → x, built at the first expansion
 };
 
 struct Flexibility;

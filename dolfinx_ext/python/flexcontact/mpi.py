@@ -1,6 +1,7 @@
 """MPI patterns the package uses in several places, written once."""
 from __future__ import annotations
 
+import time
 from typing import Optional, Union
 
 
@@ -23,3 +24,22 @@ def raise_on_every_rank(comm, error: Optional[Union[str, BaseException]],
     if isinstance(error, BaseException):
         raise error
     raise kind(error)
+
+
+def wait_for_root(comm, poll_s: float = 2e-4) -> None:
+    """Hold the other ranks here until rank 0 arrives, asleep rather than spinning.
+
+    While rank 0 works alone (the kernel's contact solve of an increment), a blocking MPI
+    call keeps each waiting rank polling at full speed on a core; on a machine with fewer
+    free cores than busy processes that core is taken from rank 0. A non-blocking barrier
+    tested every ``poll_s`` seconds lets them sleep instead (rank 0 waits for nothing: the
+    others arrived first). Collective.
+    """
+    if comm.size == 1:
+        return
+    request = comm.Ibarrier()
+    if comm.rank == 0:
+        request.Wait()
+        return
+    while not request.Test():
+        time.sleep(poll_s)

@@ -25,7 +25,7 @@ from ._cpp import ConvergenceError, SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
 from . import factor_path
-from .mpi import raise_on_every_rank
+from .mpi import raise_on_every_rank, wait_for_root
 from .names import FlexibilityMethod, Ordering, check_chain, check_flexibility_method, \
     check_ordering
 from .pairing import PAIRINGS, pair_interfaces
@@ -323,6 +323,7 @@ class ContactProblem:
             # kept for inspection and for cross-checks with other solvers.
             if q is not None:
                 self.local_problem = {"dim": self.dim, "W": self.W, "q": q, "mu": self.mu}
+        wait_for_root(self.comm)  # the others asleep through the kernel step, not spinning
         failure = self.comm.bcast(failure, root=0)
         if failure:
             for v in (p, up):
