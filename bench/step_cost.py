@@ -1,8 +1,10 @@
 """What one impact time step costs, in back-substitutions with the stored factor of Ŵ.
 
 The method's promise in time (docs/impact.md): Ŵ = M + hθC + h²θ²K is factored once per
-time-step size; a step is one back-substitution for the free velocity plus, only when a
-contact impulse acts, a second one for the correction. This runs the bar-on-wall impact
+time-step size; a step is one back-substitution, split around the contact solve
+(condensation of the step's right-hand side, the kernel's step, expansion) with MUMPS's
+Schur factor, else one for the free velocity plus, only when a contact impulse acts, a
+second one for the correction. This runs the bar-on-wall impact
 (and then some free flight) at growing sizes and reports, measured in the same run, the
 back-substitutions per step (mean, and the medians of steps with and without contact), the
 time of one step against one back-substitution, and the set-up (assembly, factorization

@@ -107,6 +107,7 @@ def summarise(case, target, problem, records, dt, comm):
         "energy_balance_error_rel": e.balance_error_rel,
         "max_penetration_m": max(r.max_penetration_m for r in records),
         "cost": cost_summary(records), "expected_contact_s": problem.expected_contact_s,
+        "one_back_substitution": problem.one_back_substitution,
         "timings_s": {k: v for k, v in problem.timings.items() if k != "steps_s"},
     }
     if case == "bars":

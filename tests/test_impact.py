@@ -67,11 +67,15 @@ def test_impulse_equals_change_of_momentum_and_energy_account_closes(serial, cas
     assert abs(r["energy_balance_error_rel"]) <= 0.01
 
 
-def test_a_step_costs_at_most_two_back_substitutions(serial):
+def test_a_step_costs_one_back_substitution_or_two_without_a_split_factor(serial):
     s, _ = serial
     for case in ("wall", "bars"):
         cost = s[case]["cost"]
-        assert cost["median_without_contact"] == 1 and cost["median_with_contact"] == 2
+        # A factor that condenses and expands makes every step one back-substitution; the
+        # fallback adds a second one in steps with contact.
+        with_contact = 1 if s[case]["one_back_substitution"] else 2
+        assert cost["median_without_contact"] == 1
+        assert cost["median_with_contact"] == with_contact
         assert cost["back_substitutions_per_step"] <= 2.2
 
 

@@ -4,7 +4,8 @@
 /// @brief Python binding of the Moreau–Jean contact step (kernel/.../impact.hpp).
 ///
 /// A time step crosses the binding once: step() takes the contact-DOF values of u⁻, v⁻ and
-/// v_free and hands back a plain dict of NumPy arrays and numbers.
+/// v_free (step_condensed(): u⁻, v⁻ and the condensed right-hand side) and hands back a
+/// plain dict of NumPy arrays and numbers.
 
 #include "bindings.h"
 
@@ -45,6 +46,12 @@ py::dict step_dict(const ImpactStep& r, int dim)
   d["max_penetration"] = r.max_penetration;
   d["active_pairs"] = r.active_pairs;
   d["report"] = report_dict(r.report);
+  if (r.velocity_change_c.size() > 0)
+  {
+    d["velocity_change_c"]
+        = py::array_t<double>(r.velocity_change_c.size(), r.velocity_change_c.data());
+    d["velocity_c"] = py::array_t<double>(r.velocity_c.size(), r.velocity_c.data());
+  }
   return d;
 }
 } // namespace
@@ -82,6 +89,29 @@ void flexcontact::bind_impact(py::module& m)
           "local frames), states, active, reaction (n_c, B^T P), normal_impulse, "
           "slave_impulse (d, global), pair_tangential, friction_work, contact_work, "
           "max_penetration, active_pairs, report")
+      .def(
+          "step_condensed",
+          [convergence_error](ImpactContact& c, const Vector& u_c, const Vector& v_c,
+                              const Vector& b_c)
+          {
+            ImpactStep r;
+            try
+            {
+              py::gil_scoped_release release;
+              r = c.step_condensed(u_c, v_c, b_c);
+            }
+            catch (const ConvergenceError& e)
+            {
+              raise_convergence_error(convergence_error, e);
+            }
+            return step_dict(r, c.dim());
+          },
+          py::arg("u_c"), py::arg("v_c"), py::arg("b_c"),
+          "The step from the condensed right-hand side b_c - What_ci What_ii^-1 b_i "
+          "(SchurFactor.condense of b = h [f - C v- - K (u- + h theta v-)]): the free "
+          "velocity v_c + Fhat b_c, then as step(). The dict also holds velocity_change_c "
+          "(n_c, Fhat (b_c + r_c): its expansion by the factor is the whole step's "
+          "velocity change) and velocity_c (v+ on the contact DOFs)")
       .def("set_flexibility", &ImpactContact::set_flexibility, py::arg("F"), py::arg("dt_s"),
            "New F-hat (another time step): W_eff rebuilt, pairs kept")
       .def("set_pairs", &ImpactContact::set_pairs, py::arg("pairs"), py::arg("mu"),

@@ -162,6 +162,25 @@ ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
   return r;
 }
 
+ImpactStep ImpactContact::step_condensed(const Eigen::Ref<const Vector>& u_c,
+                                         const Eigen::Ref<const Vector>& v_c,
+                                         const Eigen::Ref<const Vector>& b_c)
+{
+  check_vector("b_c", b_c, F_.rows());
+  check_vector("v_c", v_c, F_.rows());
+  // F_ has the held rows and columns zeroed; Ŵ's identity rows give them (Ŵ⁻¹)_ii = 1.
+  Vector dv_free = F_ * b_c;
+  for (std::size_t i = 0; i < constrained_.size(); ++i)
+    if (constrained_[i])
+      dv_free[static_cast<Eigen::Index>(i)] = b_c[static_cast<Eigen::Index>(i)];
+  const Vector vfree_c = v_c + dv_free;
+  ImpactStep r = step(u_c, v_c, vfree_c);
+  // r_c is zero on held DOFs, where F_'s zeroed columns leave dv_free's value.
+  r.velocity_change_c = dv_free + F_ * r.reaction;
+  r.velocity_c = v_c + r.velocity_change_c;
+  return r;
+}
+
 void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
 {
   const int m = pairs(), d = dim_;

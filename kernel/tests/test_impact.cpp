@@ -3,7 +3,8 @@
 /// @file test_impact.cpp
 /// @brief The Moreau–Jean contact step on small systems integrated here with dense algebra:
 /// a mass–spring hitting a rigid wall (impulse, contact duration, energy), restitution of a
-/// single mass, Coulomb friction on impulses, and bad input.
+/// single mass, Coulomb friction on impulses, the step from the condensed right-hand side
+/// (one back-substitution) against the two-solve step, and bad input.
 
 #include "contact_testing.hpp"
 #include "flexcontact/impact.hpp"
@@ -42,8 +43,12 @@ double energy(const Matrix& M, const Matrix& K, const Vector& u, const Vector& v
 }
 
 /// @brief Integrates the θ = ½ scheme for `steps` steps of size h from v0 on both masses
-/// (spring on: the mass–spring; spring off and back mass far: a single mass).
-ImpactRun integrate(double h, int steps, const Vector& v0, double e, double mu, double kk = k)
+/// (spring on: the mass–spring; spring off and back mass far: a single mass). `split`: each
+/// step as one back-substitution (step_condensed from the condensed right-hand side, then
+/// the interior's velocity from the returned contact values, by dense algebra here) instead
+/// of the two solves v_free = v + Ŵ⁻¹ res, v⁺ = v_free + Ŵ⁻¹ Bᵀ P.
+ImpactRun integrate(double h, int steps, const Vector& v0, double e, double mu, double kk = k,
+                    bool split = false)
 {
   const double theta = 0.5;
   Matrix M = Matrix::Zero(6, 6), K = Matrix::Zero(6, 6);
@@ -74,15 +79,35 @@ ImpactRun integrate(double h, int steps, const Vector& v0, double e, double mu, 
       x[a] = g[contact_dofs[a]];
     return x;
   };
+  // The interior DOFs (the back node's) for the split step's condensation and expansion.
+  const std::vector<int> inner{2, 3};
+  const Matrix Wii = What(inner, inner), Wic = What(inner, contact_dofs);
+  const Eigen::LLT<Matrix> inner_factor(Wii);
   for (int i = 0; i < steps; ++i)
   {
     const Vector res = -h * (K * (u + h * theta * v));
-    const Vector vfree = v + factor.solve(res);
-    const ImpactStep s = c.step(gather(u), gather(v), gather(vfree));
-    Vector rg = Vector::Zero(6);
-    for (int a = 0; a < 4; ++a)
-      rg[contact_dofs[a]] = s.reaction[a];
-    const Vector vnew = vfree + factor.solve(rg);
+    Vector vnew(6);
+    ImpactStep s;
+    if (split)
+    {
+      const Vector res_i = res(inner);
+      const Vector b_c = gather(res) - Wic.transpose() * inner_factor.solve(res_i);
+      s = c.step_condensed(gather(u), gather(v), b_c);
+      Vector dv(6);
+      dv(contact_dofs) = s.velocity_change_c;
+      const Vector dv_i = inner_factor.solve(res_i - Wic * s.velocity_change_c);
+      dv(inner) = dv_i;
+      vnew = v + dv;
+    }
+    else
+    {
+      const Vector vfree = v + factor.solve(res);
+      s = c.step(gather(u), gather(v), gather(vfree));
+      Vector rg = Vector::Zero(6);
+      for (int a = 0; a < 4; ++a)
+        rg[contact_dofs[a]] = s.reaction[a];
+      vnew = vfree + factor.solve(rg);
+    }
     u += h * (theta * vnew + (1 - theta) * v);
     v = vnew;
     r.impulse_x += s.slave_impulse[0];
@@ -144,6 +169,70 @@ TEST(Impact, FrictionImpulseIsMuTimesNormalWhileSliding)
   // Slow along the wall: it sticks, and the tangential velocity stops.
   const ImpactRun s = integrate(1e-3, 20, vec({-vn, 0.1}), e, mu, 0.0);
   EXPECT_NEAR(s.v[1], 0.0, 1e-9);
+}
+
+TEST(Impact, CondensedStepIsTheTwoSolveStep)
+{
+  // The same runs with each step split (condensed right-hand side in, contact-DOF velocity
+  // change out, the rest by expansion): the states agree to round-off, with and without
+  // friction, restitution and the spring.
+  struct Case
+  {
+    double h;
+    int steps;
+    Vector v0;
+    double e, mu, kk;
+  };
+  const double omega = std::sqrt(k / m), tc = std::numbers::pi / omega;
+  const std::vector<Case> cases{{tc / 400, 600, vec({-1.5, 0.0}), 0.0, 0.0, k},
+                                {1e-3, 20, vec({-2.0, 0.0}), 0.5, 0.0, 0.0},
+                                {1e-3, 20, vec({-1.0, 3.0}), 0.5, 0.3, 0.0},
+                                {tc / 200, 300, vec({-1.0, 0.5}), 0.2, 0.3, k}};
+  for (const Case& cs : cases)
+  {
+    const ImpactRun a = integrate(cs.h, cs.steps, cs.v0, cs.e, cs.mu, cs.kk, true);
+    const ImpactRun b = integrate(cs.h, cs.steps, cs.v0, cs.e, cs.mu, cs.kk, false);
+    ASSERT_GE(b.first_contact, 0);
+    EXPECT_EQ(a.first_contact, b.first_contact);
+    EXPECT_EQ(a.last_contact, b.last_contact);
+    EXPECT_LE((a.v - b.v).norm(), 1e-12 * b.v.norm()) << "mu = " << cs.mu;
+    EXPECT_LE((a.u - b.u).norm(), 1e-12 * std::max(b.u.norm(), 1e-300));
+    EXPECT_NEAR(a.impulse_x, b.impulse_x, 1e-12 * std::abs(b.impulse_x));
+    EXPECT_NEAR(a.contact_work, b.contact_work, 1e-12 * b.energy0);
+    EXPECT_NEAR(a.friction_work, b.friction_work, 1e-12 * b.energy0);
+  }
+}
+
+TEST(Impact, CondensedStepHoldsHeldDofsAndNamesBadInput)
+{
+  // Held DOFs (the wall's, 2 and 3 here) take Ŵ's identity rows: their velocity change is
+  // the condensed right-hand side itself, and the reaction does not reach them.
+  const Matrix F = (Matrix(4, 4) << 2, 1, 0, 0, 1, 3, 0, 0, 0, 0, 5, 0, 0, 0, 0, 7).finished();
+  ImpactContact c(2, F, Matrix::Zero(2, 2), {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))},
+                  vec({0.0}), 0.0, 1e-3, 0.5, wall_held);
+  const Vector z = Vector::Zero(4), b = vec({-1.0, 0.5, 0.25, -0.125});
+  const ImpactStep s = c.step_condensed(z, z, b);
+  ASSERT_EQ(s.active_pairs, 1);
+  // W_eff = F_00 = 2 on the normal; U_free,n = (F b)_0 − b_2 = −1.5 − 0.25, so
+  // P_n = 0.875 and U_n⁺ = 0; the reaction is on the slave's DOFs only.
+  EXPECT_NEAR(s.impulse[0], 0.875, 1e-10);
+  EXPECT_NEAR(s.velocity[0], 0.0, 1e-10);
+  const Vector r = vec({0.875, 0.0, 0.0, 0.0});
+  const Vector expected = vec({(F * (b + r))[0], (F * (b + r))[1], b[2], b[3]});
+  EXPECT_LE((s.velocity_change_c - expected).norm(), 1e-10);
+  EXPECT_EQ((s.velocity_c - s.velocity_change_c).norm(), 0.0);
+  // The same step from v_free = v + F b (held DOFs: + b) gives the same impulse.
+  const Vector vfree = vec({(F * b)[0], (F * b)[1], b[2], b[3]});
+  ImpactContact d(2, F, Matrix::Zero(2, 2), {make_pair(0, {1}, {1.0}, vec({1.0, 0.0}))},
+                  vec({0.0}), 0.0, 1e-3, 0.5, wall_held);
+  EXPECT_NEAR(d.step(z, z, vfree).impulse[0], s.impulse[0], 1e-12);
+  EXPECT_EQ(d.step(z, z, vfree).velocity_change_c.size(), 0);
+  EXPECT_NE(message_of([&] { c.step_condensed(z, z, Vector::Zero(3)); })
+                .find("b_c has 3 entries"),
+            std::string::npos);
+  const Vector bad = vec({NAN, 0.0, 0.0, 0.0});
+  EXPECT_NE(message_of([&] { c.step_condensed(z, z, bad); }).find("b_c is not finite"),
+            std::string::npos);
 }
 
 namespace

@@ -1,14 +1,23 @@
 """Impact: dynamic contact on the condensed system by the Moreau–Jean θ-scheme at velocity
 level, with Newton restitution and Coulomb friction on impulses (docs/impact.md).
 
-One time step of size h, with r = h [f − C v⁻ − K (u⁻ + hθ v⁻)]:
+One time step of size h, with r = h [f − C v⁻ − K (u⁻ + hθ v⁻)], is one back-substitution
+with the stored factor of Ŵ = M + hθC + h²θ²K (factored once per time-step size) when the
+factor splits its solves (``factor.has_condense``: MUMPS's Schur factor, serial or
+distributed):
 
-1. free velocity v_free = v⁻ + Ŵ⁻¹ r (one back-substitution with the stored factor of
-   Ŵ = M + hθC + h²θ²K, factored once per time-step size);
-2. the contact impulses P from U⁺ = W_eff P + B v_free, W_eff = B Ŵ⁻¹ Bᵀ, in the kernel
-   (``_cpp.ImpactContact``; one crossing of the binding);
-3. only in steps with contact, v⁺ = v_free + Ŵ⁻¹ Bᵀ P (a second back-substitution);
+1. r condensed onto the contact DOFs, r̃_c = r_c − Ŵ_ci Ŵ_ii⁻¹ r_i (forward elimination);
+2. in the kernel (``_cpp.ImpactContact.step_condensed``; one crossing of the binding): the
+   free velocity v_free,c = v⁻_c + F̂ r̃_c, the contact impulses P from
+   U⁺ = W_eff P + B v_free, W_eff = B F̂ Bᵀ, and Δv_c = F̂ (r̃_c + Bᵀ P);
+3. the expansion from Δv_c (backward substitution): Δv = Ŵ⁻¹ (r + Bᵀ P), v⁺ = v⁻ + Δv,
+   with or without contact;
 4. u⁺ = u⁻ + h (θ v⁺ + (1 − θ) v⁻).
+
+With a factor that cannot split (another flexibility method, or a PETSc whose MUMPS layout
+is not the expected one: ``flex_info["condense_fallback"]``), v_free = v⁻ + Ŵ⁻¹ r is a full
+solve, the kernel's ``step`` takes it, and steps with contact add v⁺ = v_free + Ŵ⁻¹ Bᵀ P,
+a second solve.
 
 A body with no Dirichlet condition at all is fine: Ŵ is regular where K is not. Rank 0 holds
 the condensed problem, as in the static ContactProblem.
@@ -289,12 +298,19 @@ class ImpactProblem:
         return {b.name: total[i].tolist() for i, b in enumerate(self.bodies)}
 
     # ---- one time step ---------------------------------------------------------------
+    @property
+    def one_back_substitution(self) -> bool:
+        """True when a time step is one back-substitution (the factor condenses and
+        expands); False: the two-solve fallback (two solves in steps with contact)."""
+        return bool(getattr(self.factor, "has_condense", False))
+
     def _solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
         self.factor.solve(b, x)
         self.back_substitutions += 1
 
-    def _free_velocity(self) -> PETSc.Vec:
-        """v_free = v⁻ + Ŵ⁻¹ h [f − C v⁻ − K (u⁻ + hθ v⁻)]."""
+    def _step_rhs(self) -> PETSc.Vec:
+        """r = h [f − C v⁻ − K (u⁻ + hθ v⁻)] in a work vector (overwritten by the next
+        step's energy bookkeeping)."""
         h, (alpha, beta) = self.dt, self.rayleigh
         w, r, _ = self._work
         self.u_vec.copy(w)
@@ -306,19 +322,57 @@ class ImpactProblem:
             r.axpy(-h * alpha, w)
         if self.f is not None:
             r.axpy(h, self.f)
+        return r
+
+    def _free_velocity(self) -> PETSc.Vec:
+        """v_free = v⁻ + Ŵ⁻¹ h [f − C v⁻ − K (u⁻ + hθ v⁻)] (a full solve)."""
         vfree = self.K.createVecLeft()
-        self._solve(r, vfree)
+        self._solve(self._step_rhs(), vfree)
         vfree.axpy(1.0, self.v_vec)
         return vfree
 
-    def _contact(self, vfree: PETSc.Vec) -> Optional[dict]:
-        """The kernel's contact step on rank 0 (None elsewhere); errors on every rank."""
+    def _split_velocity(self) -> tuple[PETSc.Vec, Optional[dict]]:
+        """v⁺ and the kernel's step by one back-substitution: the step's right-hand side
+        condensed, the kernel's step from it, the expansion from its Δv_c."""
+        rc = self.factor.condense(self._step_rhs())
+        out = self._contact(rc, condensed=True)
+        root = self.comm.rank == 0
+        v_new = self.K.createVecLeft()
+        dv_c = np.asarray(out["velocity_change_c"]) if root else np.zeros(0)
+        self.factor.expand(dv_c, v_new)
+        self.back_substitutions += 1
+        v_new.axpy(1.0, self.v_vec)
+        return v_new, out
+
+    def _two_solve_velocity(self) -> tuple[PETSc.Vec, Optional[dict]]:
+        """v⁺ and the kernel's step with full solves: v_free, then, only when an impulse
+        acts, v⁺ = v_free + Ŵ⁻¹ Bᵀ P."""
+        vfree = self._free_velocity()
+        out = self._contact(self.condensation.gather(vfree), condensed=False)
+        root = self.comm.rank == 0
+        pushed = self.comm.bcast(bool(np.any(out["reaction"] != 0.0)) if root else None,
+                                 root=0)
+        if pushed:
+            r = self.condensation.reaction(out["reaction"] if root else None)
+            dv = self.K.createVecLeft()
+            self._solve(r, dv)
+            vfree.axpy(1.0, dv)
+            for o in (r, dv):
+                o.destroy()
+        return vfree, out
+
+    def _contact(self, b_or_vfree_c: Optional[np.ndarray], condensed: bool) -> Optional[dict]:
+        """The kernel's contact step on rank 0 (None elsewhere); errors on every rank.
+        ``b_or_vfree_c`` (rank 0): the condensed right-hand side when ``condensed``, else the
+        contact values of v_free."""
         c = self.condensation
-        uc, vc, vfc = c.gather(self.u_vec), c.gather(self.v_vec), c.gather(vfree)
+        uc, vc = c.gather(self.u_vec), c.gather(self.v_vec)
         out, failure = None, None
         if self.comm.rank == 0:
             try:
-                out = self.contact.step(uc, vc, vfc)  # the step's one crossing
+                # the step's one crossing
+                step = self.contact.step_condensed if condensed else self.contact.step
+                out = step(uc, vc, np.asarray(b_or_vfree_c))
             except ConvergenceError as e:
                 failure = (f"time step {len(self.records) + 1}: {e}",
                            dict(getattr(e, "report", {})))
@@ -339,19 +393,10 @@ class ImpactProblem:
         n_solves = self.back_substitutions
         if self.repairing and self.records:
             self.repair()
-        vfree = self._free_velocity()
-        out = self._contact(vfree)
-        root = self.comm.rank == 0
-        pushed = self.comm.bcast(bool(np.any(out["reaction"] != 0.0)) if root else None,
-                                 root=0)
-        v_new = vfree
-        if pushed:
-            r = self.condensation.reaction(out["reaction"] if root else None)
-            dv = self.K.createVecLeft()
-            self._solve(r, dv)
-            v_new.axpy(1.0, dv)
-            for o in (r, dv):
-                o.destroy()
+        if self.one_back_substitution:
+            v_new, out = self._split_velocity()
+        else:
+            v_new, out = self._two_solve_velocity()
         du = self.K.createVecLeft()
         du.axpy(self.dt * self.theta, v_new)
         du.axpy(self.dt * (1.0 - self.theta), self.v_vec)

@@ -50,15 +50,21 @@ struct ImpactStep
   double contact_work = 0.0;
   double max_penetration = 0.0;   ///< max(0, −min_k g_n,k) at the start of the step
   int active_pairs = 0;           ///< |I|
+  /// n_c, Δv_c = v⁺_c − v⁻_c = F̂ (b̃_c + r_c) on the contact DOFs (step_condensed only,
+  /// empty after step): the contact values from which the factor's expansion of the
+  /// condensed right-hand side b̃_c gives the step's whole Δv = Ŵ⁻¹ (b + Bᵀ P)
+  Vector velocity_change_c;
+  Vector velocity_c;              ///< n_c, v⁺_c = v⁻_c + Δv_c (step_condensed only)
 };
 
 /// @brief The contact part of a Moreau–Jean time step on the condensed system.
 ///
 /// Holds B, x0 and W_eff = B F̂ Bᵀ for one time-step size, the restitution coefficient and
 /// the last impulses (warm start). Stateless otherwise: the step gets the contact-DOF values
-/// of u⁻, v⁻ and the free velocity v_free = v⁻ + Ŵ⁻¹ h r, so that one step crosses the
-/// binding once. A contact DOF held by a Dirichlet condition gets no flexibility (rows and
-/// columns of F̂ zeroed): a body whose nodes are all held is exactly rigid.
+/// of u⁻, v⁻ and the free velocity v_free = v⁻ + Ŵ⁻¹ h r (step) or the condensed h r
+/// (step_condensed), so that one step crosses the binding once. A contact DOF held by a
+/// Dirichlet condition gets no flexibility (rows and columns of F̂ zeroed): a body whose
+/// nodes are all held is exactly rigid.
 class ImpactContact
 {
 public:
@@ -81,6 +87,23 @@ public:
   /// @throws ConvergenceError if no local solver converges (the warm start is kept)
   ImpactStep step(const Eigen::Ref<const Vector>& u_c, const Eigen::Ref<const Vector>& v_c,
                   const Eigen::Ref<const Vector>& vfree_c);
+
+  /// @brief The same step from the condensed right-hand side, so that the whole time step
+  /// is one back-substitution with a factor that splits its solves (MUMPS condensation and
+  /// expansion).
+  ///
+  /// b_c = b̃_c = b_c − Ŵ_ci Ŵ_ii⁻¹ b_i is the condensation onto the contact DOFs of the
+  /// step's right-hand side b = h [f − C v⁻ − K (u⁻ + hθ v⁻)] (forward elimination only).
+  /// The free velocity is v_free,c = v_c + F̂ b̃_c (a held DOF has an identity row in Ŵ:
+  /// v_free,c = v_c + b̃_c there), then step() as above; the result also holds
+  /// velocity_change_c = F̂ (b̃_c + r_c) (held DOFs: b̃_c), whose expansion is the whole
+  /// Δv = Ŵ⁻¹ (b + Bᵀ P): r = Bᵀ P lives on the contact DOFs and leaves the interior's
+  /// forward elimination unchanged.
+  /// @throws std::invalid_argument on wrong sizes or non-finite values
+  /// @throws ConvergenceError if no local solver converges (the warm start is kept)
+  ImpactStep step_condensed(const Eigen::Ref<const Vector>& u_c,
+                            const Eigen::Ref<const Vector>& v_c,
+                            const Eigen::Ref<const Vector>& b_c);
 
   /// @brief New pairs on the same contact nodes (re-pairing between steps): B, x0 and
   /// W_eff rebuilt from the stored F̂, no factorization. Pair k keeps its last impulse and
