@@ -9,7 +9,7 @@ bench/campaign.json: per class, how many each solved, wrong answers claimed (mus
 problems the chain lost that another solver solved (must be 0), the worst residual of a
 claimed answer, and median times.
 
-    /usr/bin/python3 bench/campaign.py [--count 10000] [--large 4] [--seed 1]   # about 40 min
+    /usr/bin/python3 bench/campaign.py [--count 10000] [--large 8] [--seed 1]   # 25 min on a quiet machine
     /usr/bin/python3 bench/campaign.py --count 2000 --large 0 --also "$(python3 -c \
         'import json; print(",".join(x["problem"] for x in json.load(open("bench/campaign.json"))["lost_by_the_chain"]))')"
 """
