@@ -44,19 +44,29 @@ def dense_bytes(n_contact_dofs: int, pairs: int, dim: int) -> float:
     return 8.0 * (FSTAR_COPIES * float(n_contact_dofs) ** 2 + W_COPIES * float(pairs * dim) ** 2)
 
 
+def _env_gb(name: str, zero_allowed: bool) -> Optional[float]:
+    """Bytes from the environment variable ``name`` given in GB, None when it is not set;
+    a ValueError naming it and its value otherwise."""
+    env = os.environ.get(name)
+    if not env:
+        return None
+    try:
+        value = float(env)
+    except ValueError:
+        raise ValueError(f"{name}={env!r}; it must be a number of GB") from None
+    if not (value >= 0 if zero_allowed else value > 0):
+        raise ValueError(f"{name}={env!r}; it must be "
+                         + ("≥ 0 GB" if zero_allowed else "a positive number of GB"))
+    return value * 1e9
+
+
 def available_bytes() -> float:
     """The memory available now: ``MemAvailable`` of /proc/meminfo, or the environment
     variable FLEXCONTACT_AVAILABLE_MEMORY_GB (in GB) when set (tests, or to leave room for
     other processes). Infinite if neither can be read."""
-    env = os.environ.get(ENV_AVAILABLE)
-    if env:
-        try:
-            value = float(env)
-        except ValueError:
-            raise ValueError(f"{ENV_AVAILABLE}={env!r}; it must be a number of GB") from None
-        if not value > 0:
-            raise ValueError(f"{ENV_AVAILABLE}={env!r}; it must be a positive number of GB")
-        return value * 1e9
+    env = _env_gb(ENV_AVAILABLE, zero_allowed=False)
+    if env is not None:
+        return env
     try:
         with open("/proc/meminfo") as f:
             for line in f:
@@ -109,14 +119,8 @@ def working_set_bytes() -> float:
     """Memory for the factor path's columns of W (bytes): FLEXCONTACT_WORKING_SET_GB when
     set (0 turns the working set off: the matrix-free iteration only), otherwise a quarter
     of available_bytes()."""
-    env = os.environ.get(ENV_WORKING_SET)
-    if env:
-        try:
-            value = float(env)
-        except ValueError:
-            raise ValueError(f"{ENV_WORKING_SET}={env!r}; it must be a number of GB") from None
-        if not value >= 0:
-            raise ValueError(f"{ENV_WORKING_SET}={env!r}; it must be ≥ 0 GB")
-        return value * 1e9
+    env = _env_gb(ENV_WORKING_SET, zero_allowed=True)
+    if env is not None:
+        return env
     avail = available_bytes()
     return WORKING_SET_SHARE * avail if avail < float("inf") else 1e12
