@@ -94,16 +94,8 @@ void flexcontact::bind_impact(py::module& m)
           [convergence_error](ImpactContact& c, const Vector& u_c, const Vector& v_c,
                               const Vector& b_c)
           {
-            ImpactStep r;
-            try
-            {
-              py::gil_scoped_release release;
-              r = c.step_condensed(u_c, v_c, b_c);
-            }
-            catch (const ConvergenceError& e)
-            {
-              raise_convergence_error(convergence_error, e);
-            }
+            const ImpactStep r = step_or_raise(
+                convergence_error, [&] { return c.step_condensed(u_c, v_c, b_c); });
             return step_dict(r, c.dim());
           },
           py::arg("u_c"), py::arg("v_c"), py::arg("b_c"),
