@@ -36,6 +36,17 @@ def mpirun(n, script, *args, timeout=600, cwd=None, env=None):
     return subprocess.CompletedProcess(cmd, 0, out, err)
 
 
+def on_two_ranks(script, *args, timeout=600, **kwargs):
+    """Run ``script`` with ``mpirun -n 2`` from a serial pytest (the MPI tests' pattern);
+    skipped when pytest itself runs under MPI or mpirun is missing."""
+    from mpi4py import MPI
+    if MPI.COMM_WORLD.size > 1:
+        pytest.skip("runs its own mpirun")
+    if shutil.which("mpirun") is None:
+        pytest.skip("mpirun not available")
+    return mpirun(2, script, *args, timeout=timeout, **kwargs)
+
+
 @pytest.fixture
 def results_dir(tmp_path, monkeypatch):
     """Demos write under a temporary results folder."""

@@ -1,7 +1,6 @@
 """The condensed problem behind one binding call (``_cpp.CondensedContact``) against the
 low-level kernel functions, and the report that a failed increment carries on every rank."""
 import json
-import shutil
 import sys
 from pathlib import Path
 
@@ -10,7 +9,7 @@ import pytest
 from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from conftest import mpirun  # noqa: E402
+from conftest import on_two_ranks  # noqa: E402
 
 import flexcontact as fc  # noqa: E402
 from flexcontact import _cpp  # noqa: E402
@@ -152,11 +151,8 @@ def test_failed_increment_carries_the_report():
 
 
 @pytest.mark.mpi
-@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
 def test_failed_increment_carries_the_report_on_every_rank(tmp_path):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
-    mpirun(2, __file__, tmp_path, timeout=300)
+    on_two_ranks(__file__, tmp_path, timeout=300)
     for rank in range(2):
         _check_report(*json.loads((tmp_path / f"report{rank}.json").read_text()))
 

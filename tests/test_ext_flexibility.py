@@ -6,13 +6,12 @@ a dense solve, singular stiffness and bad input as Python exceptions, and serial
 `mpirun -n 2` (where the default "schur" drives MUMPS directly: tests/test_mpi_schur.py).
 Run as a script (under mpirun) it writes F* of every method to the file given.
 """
-import shutil
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from conftest import mpirun
+from conftest import on_two_ranks
 import pytest
 import ufl
 from mpi4py import MPI
@@ -211,12 +210,9 @@ def _write_flexibility(path):
         np.savez(path, **out)
 
 
-@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
 def test_two_ranks_match_serial(tmp_path):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
     path = tmp_path / "flex2.npz"
-    mpirun(2, __file__, path)
+    on_two_ranks(__file__, path)
     par = np.load(path)
     for dim, n in [(2, 6), (3, 3)]:
         msh, V, K, tags = elasticity(n, dim)

@@ -9,7 +9,6 @@ interleaved across ranks): the per-body F* against the one-block F* (to 1e-12) a
 inverse of K (to 1e-10), exact zeros between bodies, the bodies found, and serial against
 `mpirun -n 2`. Run as a script (under mpirun) it writes the F* of each case to the file given.
 """
-import shutil
 import sys
 
 import numpy as np
@@ -17,7 +16,7 @@ import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from conftest import mpirun
+from conftest import on_two_ranks
 from test_ext_flexibility import contact_dofs, dense, elasticity, fc, rel
 
 # (dim, n, E) of each body: different sizes and moduli, so no two blocks are alike.
@@ -131,12 +130,9 @@ def _write(path):
         np.savez(path, **out)
 
 
-@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
 def test_two_ranks_match_serial(tmp_path):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
     path = tmp_path / "perbody2.npz"
-    mpirun(2, __file__, path)
+    on_two_ranks(__file__, path)
     par = np.load(path)
     for case in CASES:
         # The contact DOFs are the same nodes in the same order in either run (each body's

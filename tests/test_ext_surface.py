@@ -5,13 +5,12 @@ against the space's own DOF coordinates, the missing-tag error, write-back round
 serial against `mpirun -n 2`. Run as a script (under mpirun) it writes its results to the
 file given.
 """
-import shutil
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from conftest import mpirun
+from conftest import on_two_ranks
 import pytest
 from mpi4py import MPI
 
@@ -183,12 +182,9 @@ def _write_surface(path):
         np.savez(path, **out)
 
 
-@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
 def test_two_ranks_match_serial(tmp_path):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
     path = tmp_path / "surface2.npz"
-    mpirun(2, __file__, path)
+    on_two_ranks(__file__, path)
     par = np.load(path)
     for dim, n in [(2, 6), (3, 3)]:
         msh, V, tags = tagged_box(n, dim)

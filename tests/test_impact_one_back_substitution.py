@@ -14,7 +14,6 @@ the bar re-paired node-to-surface before every step.
 """
 import json
 import math
-import shutil
 import sys
 from pathlib import Path
 
@@ -23,7 +22,7 @@ import pytest
 from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from conftest import mpirun  # noqa: E402
+from conftest import on_two_ranks  # noqa: E402
 
 E, RHO, L, V0 = 200e9, 8000.0, 1.0, 1.0
 C = math.sqrt(E / RHO)
@@ -141,12 +140,8 @@ def test_split_step_gives_the_two_solve_step_serial(case):
 
 @pytest.fixture(scope="module")
 def two_ranks(tmp_path_factory):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
-    if shutil.which("mpirun") is None:
-        pytest.skip("mpirun not available")
     folder = tmp_path_factory.mktemp("impact_split")
-    mpirun(2, __file__, folder, timeout=600)
+    on_two_ranks(__file__, folder, timeout=600)
     return json.loads((folder / "compare.json").read_text())
 
 

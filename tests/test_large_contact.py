@@ -9,7 +9,6 @@ agree to that tolerance times W's conditioning in λ. The references are the den
 from __future__ import annotations
 
 import json
-import shutil
 import sys
 from pathlib import Path
 
@@ -24,7 +23,7 @@ from flexcontact.memory import ENV_AVAILABLE, ENV_WORKING_SET, dense_bytes
 from flexcontact.meshes import hertz2d, hertz3d, tags
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from conftest import mpirun  # noqa: E402
+from conftest import on_two_ranks  # noqa: E402
 
 R_M, A_M = 0.05, 0.005
 STEEL = forms.Material(E_Pa=200e9, nu=0.3)
@@ -156,15 +155,12 @@ def _summary(build):
     return {"norm": norm, "normal_force": s.normal_force, "iterations": s.iterations}
 
 
-@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
 def test_factor_path_two_ranks_give_the_serial_answer(tmp_path):
     # Every rank runs the same iteration on replicated contact vectors, each product a
     # collective solve: the answer is the serial one to rounding (MUMPS's parallel solve).
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
     build = {"refine": 0, "zone_factor": 1.25}
     serial = _summary(build)
-    mpirun(2, __file__, tmp_path, timeout=600)
+    on_two_ranks(__file__, tmp_path, timeout=600)
     parallel = json.loads((tmp_path / "parallel.json").read_text())
     assert parallel["norm"] == pytest.approx(serial["norm"], rel=1e-10)
     assert parallel["normal_force"] == pytest.approx(serial["normal_force"], rel=1e-10)

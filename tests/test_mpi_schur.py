@@ -9,7 +9,6 @@ expansion x_i = K_ii⁻¹ (b_i − K_ic u_c)). A whole 2D Hertz ContactProblem w
 run on two ranks, gives the serial displacement and contact pressure at every node.
 """
 import json
-import shutil
 import sys
 from pathlib import Path
 
@@ -19,7 +18,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from conftest import mpirun
+from conftest import on_two_ranks
 from test_ext_flexibility import contact_dofs, dense, elasticity
 
 import flexcontact as fc
@@ -156,12 +155,8 @@ def hertz_record(increments=3, mu=0.3):
 # ---- the tests (one process) -------------------------------------------------------------
 @pytest.fixture(scope="module")
 def two_ranks(tmp_path_factory):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
-    if shutil.which("mpirun") is None:
-        pytest.skip("mpirun not available")
     folder = tmp_path_factory.mktemp("mpi_schur")
-    mpirun(2, __file__, folder, timeout=600)
+    on_two_ranks(__file__, folder, timeout=600)
     return np.load(folder / "boxes.npz"), json.loads((folder / "other.json").read_text())
 
 

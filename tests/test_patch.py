@@ -32,9 +32,9 @@ import pytest
 from mpi4py import MPI
 
 import patch_case
-from conftest import mpirun
+from conftest import on_two_ranks
 from flexcontact import compat
-from flexcontact.meshes import patch, surface_nodes, tags
+from flexcontact.meshes import patch, surface_coordinates as surface_nodes, tags
 
 COMM = MPI.COMM_WORLD
 ROUNDOFF = 1e-10       # relative; exact method, measured ≤ 1e-14 (see the module docstring)
@@ -207,7 +207,7 @@ def test_default_chain_reports_no_shear_on_held_pairs():
 @pytest.mark.mpi
 def test_patch_two_ranks_equal_serial(tmp_path):
     out = tmp_path / "patch.json"
-    mpirun(2, patch_case.__file__, "2,3", "stick,frictionless", "--out", out, timeout=300)
+    on_two_ranks(patch_case.__file__, "2,3", "stick,frictionless", "--out", out, timeout=300)
     for par in json.loads(out.read_text()):
         ser = result(par["dim"], par["case"])
         label = f'{par["dim"]}D {par["case"]}'

@@ -3,7 +3,6 @@ equilibrium from the contact forces (Σλ_n = N, Σλ_t = Q), partial slip below
 equilibrium past μN (named), the minimum-norm slide of a frictionless block, and the same
 answer on two MPI ranks. References from the formulas, not from the demo's output."""
 import json
-import shutil
 import sys
 import warnings
 from pathlib import Path
@@ -14,7 +13,7 @@ import ufl
 from mpi4py import MPI
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from conftest import mpirun  # noqa: E402
+from conftest import on_two_ranks  # noqa: E402
 from demo_runner import run_demo  # noqa: E402
 
 import dolfinx.fem  # noqa: E402
@@ -161,12 +160,9 @@ def _mpi_record():
 
 
 @pytest.mark.mpi
-@pytest.mark.skipif(shutil.which("mpirun") is None, reason="mpirun not available")
 def test_two_ranks_equal_serial(tmp_path):
-    if MPI.COMM_WORLD.size > 1:
-        pytest.skip("runs its own mpirun")
     serial = _mpi_record()
-    mpirun(2, __file__, tmp_path, timeout=300)
+    on_two_ranks(__file__, tmp_path, timeout=300)
     par = json.loads((tmp_path / "pushed.json").read_text())
     for key in ("N", "T"):
         np.testing.assert_allclose(par[key], serial[key], rtol=1e-10, atol=1e-10 * N)

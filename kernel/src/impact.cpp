@@ -6,13 +6,14 @@
 /// contact DOFs, and the contact terms of the energy balance.
 
 #include "constrained.hpp"
+#include "contact_checks.hpp"
+#include "message_numbers.hpp"
 #include "flexcontact/impact.hpp"
 #include "flexcontact/increment.hpp"
 #include "flexcontact/solvers.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -21,24 +22,7 @@ namespace flexcontact
 namespace
 {
 const std::string who = "flexcontact: ImpactContact: ";
-
-std::string num(double v)
-{
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-void check_flexibility(const Matrix& F, Eigen::Index n_c)
-{
-  if (F.rows() != n_c || F.cols() != n_c)
-    throw std::invalid_argument(who + "Fhat is " + std::to_string(F.rows()) + "x"
-                                + std::to_string(F.cols()) + ", expected "
-                                + std::to_string(n_c) + "x" + std::to_string(n_c)
-                                + " (contact nodes × dim)");
-  if (!F.allFinite())
-    throw std::invalid_argument(who + "Fhat is not finite");
-}
+using detail::num;
 
 void check_dt(double dt)
 {
@@ -48,22 +32,13 @@ void check_dt(double dt)
 
 void check_mu(const Vector& mu, std::size_t m)
 {
-  if (static_cast<std::size_t>(mu.size()) != m)
-    throw std::invalid_argument(who + "mu has " + std::to_string(mu.size())
-                                + " entries but there are " + std::to_string(m) + " pairs");
-  for (Eigen::Index k = 0; k < mu.size(); ++k)
-    if (!std::isfinite(mu[k]) || mu[k] < 0.0)
-      throw std::invalid_argument(who + "friction coefficient of pair " + std::to_string(k)
-                                  + " is " + num(mu[k]) + "; it must be finite and >= 0");
+  detail::check_mu_count(mu, m, who);
+  detail::check_friction(mu, who);
 }
 
 void check_vector(const char* name, const Eigen::Ref<const Vector>& v, Eigen::Index n)
 {
-  if (v.size() != n)
-    throw std::invalid_argument(who + "step: " + name + " has " + std::to_string(v.size())
-                                + " entries, expected n_c = " + std::to_string(n));
-  if (!v.allFinite())
-    throw std::invalid_argument(who + "step: " + name + " is not finite");
+  detail::check_contact_values(who + "step: ", name, v, n);
 }
 } // namespace
 
@@ -74,11 +49,8 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
       mu_(std::move(mu)), e_(restitution), dt_(dt_s), theta_(theta),
       constrained_(std::move(constrained)), options_(std::move(options))
 {
-  if (dim_ != 2 && dim_ != 3)
-    throw std::invalid_argument(who + "dim is " + std::to_string(dim_) + "; it must be 2 or 3");
-  if (X_.cols() != dim_ || !X_.allFinite())
-    throw std::invalid_argument(who + "X must be finite with dim = " + std::to_string(dim_)
-                                + " columns");
+  detail::checked_dim(dim_, who);
+  detail::check_coordinates(X_, dim_, who);
   if (!(e_ >= 0.0 && e_ <= 1.0))
     throw std::invalid_argument(who + "restitution is " + num(e_)
                                 + "; it must lie in [0, 1]");
@@ -86,7 +58,7 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   if (!(theta_ >= 0.5 && theta_ <= 1.0))
     throw std::invalid_argument(who + "theta is " + num(theta_) + "; it must lie in [0.5, 1]");
   const Eigen::Index n_c = X_.rows() * dim_;
-  check_flexibility(F_, n_c);
+  detail::check_flexibility(F_, n_c, "Fhat", who);
   check_mu(mu_, pairs_.size());
   zero_constrained(F_, constrained_, who);
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
@@ -99,7 +71,7 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
 void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
 {
   check_dt(dt_s);
-  check_flexibility(Fhat, F_.rows());
+  detail::check_flexibility(Fhat, F_.rows(), "Fhat", who);
   zero_constrained(Fhat, constrained_, who);
   W_ = delassus(B_, Fhat);
   F_ = std::move(Fhat);
