@@ -16,7 +16,7 @@ import ufl
 from mpi4py import MPI
 
 from flexcontact import compat, forms
-from flexcontact.interface import hertz_fit
+from flexcontact.contact_profile import hertz_fit
 from flexcontact.meshes import hertz2d, hertz3d, tags
 
 R_M = 0.05                  # cylinder / sphere radius [m]

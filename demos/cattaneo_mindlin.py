@@ -23,7 +23,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import hertz_fit, profile, zone_halfwidth
+from flexcontact.contact_profile import hertz_fit, profile, zone_halfwidth
 from flexcontact.meshes import hertz2d, tags
 
 parser = argparse.ArgumentParser(description=__doc__)

@@ -275,6 +275,6 @@ summary["timings_s_total"] = time.perf_counter() - t_start
 fc.write_summary(folder, summary, comm)
 if comm.rank == 0:
     import json
-    from flexcontact.dam.report import write_report
+    from flexcontact.dam.impact_report import write_report
     plain = json.loads((folder / "summary.json").read_text())
     print(f"report: {write_report(folder, plain, plain.get('mesh_study'), paraview)}")

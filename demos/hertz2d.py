@@ -24,7 +24,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import approach_to_load, hertz_fit, profile
+from flexcontact.contact_profile import approach_to_load, hertz_fit, profile
 from flexcontact.meshes import hertz2d, tags
 
 parser = argparse.ArgumentParser(description=__doc__)

@@ -18,7 +18,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import compat, forms
-from flexcontact.interface import profile
+from flexcontact.contact_profile import profile
 from flexcontact.meshes import block_on_base, tags
 
 parser = argparse.ArgumentParser(description=__doc__)

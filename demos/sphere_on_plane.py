@@ -23,7 +23,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import approach_to_load, hertz_fit
+from flexcontact.contact_profile import approach_to_load, hertz_fit
 from flexcontact.meshes import hertz3d, tags
 
 parser = argparse.ArgumentParser(description=__doc__)

@@ -29,7 +29,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import approach_to_load, elliptic_fit, hertz_fit, profile
+from flexcontact.contact_profile import approach_to_load, elliptic_fit, hertz_fit, profile
 from flexcontact.meshes import tags, two_cylinders
 
 parser = argparse.ArgumentParser(description=__doc__)

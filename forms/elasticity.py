@@ -10,6 +10,7 @@ import ufl
 from ufl.domain import extract_unique_domain
 
 from .material import Material, check_kind
+from flexcontact.errors import InputError
 
 
 def _lame(material, kind):
@@ -19,7 +20,7 @@ def _lame(material, kind):
     try:
         mu, lmbda = material
     except (TypeError, ValueError):
-        raise ValueError(
+        raise InputError(
             f"material={material!r}: expected a Material or a pair (mu, lmbda)") from None
     if kind == "plane_stress":
         lmbda = 2.0 * mu * lmbda / (lmbda + 2.0 * mu)
@@ -31,7 +32,7 @@ def _check_dim(u, kind):
     d = u.ufl_shape[0] if len(u.ufl_shape) == 1 else None
     want = 3 if kind == "3d" else 2
     if d != want:
-        raise ValueError(
+        raise InputError(
             f"kind={kind!r} needs a vector field of dimension {want}, got shape {u.ufl_shape}")
 
 
@@ -114,9 +115,9 @@ def elasticity_form(u, v, materials, dx=None, kind="plane_strain", cell_tags=Non
     if not isinstance(materials, dict):
         return ufl.inner(sigma(u, materials, kind), epsilon(v)) * dx
     if not materials:
-        raise ValueError("materials={}: need at least one cell tag -> Material")
+        raise InputError("materials={}: need at least one cell tag -> Material")
     if cell_tags is None and dx.subdomain_data() is None:
-        raise ValueError(
+        raise InputError(
             "materials is a dict but neither dx has subdomain_data nor cell_tags was given")
     if cell_tags is not None:
         _check_tags_covered(cell_tags, materials)
@@ -134,7 +135,7 @@ def _check_tags_covered(cell_tags, materials):
     present = set().union(*comm.allgather(local))
     missing = sorted(present - set(materials))
     if missing:
-        raise ValueError(
+        raise InputError(
             f"cell tags {missing} have no material (materials given for {sorted(materials)})")
 
 
@@ -164,7 +165,7 @@ def lame_fields(msh, cell_tags, materials, kind="3d"):
     n_owned = msh.topology.index_map(tdim).size_local
     n_missing = msh.comm.allreduce(int(np.count_nonzero(~seen[:n_owned])))
     if n_missing:
-        raise ValueError(f"{n_missing} cells carry no cell tag, so no material")
+        raise InputError(f"{n_missing} cells carry no cell tag, so no material")
     mu.x.scatter_forward()
     lmbda.x.scatter_forward()
     return mu, lmbda

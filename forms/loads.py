@@ -8,6 +8,7 @@ import ufl
 from ufl.domain import extract_unique_domain
 
 from .material import Material
+from flexcontact.errors import InputError
 
 WATER_DENSITY_KG_M3 = 1000.0
 STANDARD_GRAVITY_M_S2 = 9.81
@@ -30,7 +31,7 @@ def _axis(v, vertical_axis):
     d = v.ufl_shape[0]
     axis = d - 1 if vertical_axis is None else vertical_axis
     if not -d <= axis < d:
-        raise ValueError(f"vertical_axis={vertical_axis!r} out of range for dimension {d}")
+        raise InputError(f"vertical_axis={vertical_axis!r} out of range for dimension {d}")
     return d, axis % d
 
 
@@ -41,7 +42,7 @@ def surface_traction(v, t_vector, ds):
     """
     t = _as_vector(t_vector)
     if t.ufl_shape != v.ufl_shape:
-        raise ValueError(f"t_vector has shape {t.ufl_shape}, the test function {v.ufl_shape}")
+        raise InputError(f"t_vector has shape {t.ufl_shape}, the test function {v.ufl_shape}")
     return ufl.dot(t, v) * ds
 
 
@@ -78,7 +79,7 @@ def mass_form(u, v, rho, dx):
     """
     if isinstance(rho, dict):
         if not rho:
-            raise ValueError("rho={}: need at least one cell tag -> Material")
+            raise InputError("rho={}: need at least one cell tag -> Material")
         forms = [_density(m) * ufl.dot(u, v) * dx(tag) for tag, m in sorted(rho.items())]
         return sum(forms[1:], forms[0])
     return _density(rho) * ufl.dot(u, v) * dx

@@ -4,7 +4,10 @@ import math
 import numbers
 from dataclasses import dataclass
 
-KINDS = ("plane_strain", "plane_stress", "3d")
+from flexcontact.errors import InputError
+from flexcontact.names import ELASTICITY_KINDS, check_option
+
+KINDS = ELASTICITY_KINDS
 
 
 def _real(x) -> bool:
@@ -12,10 +15,9 @@ def _real(x) -> bool:
 
 
 def check_kind(kind: str) -> str:
-    """Return ``kind`` if it is one of :data:`KINDS`, else raise ValueError."""
-    if kind not in KINDS:
-        raise ValueError(f"kind={kind!r} is not one of {KINDS}")
-    return kind
+    """Return ``kind`` if it is one of :data:`KINDS` (names.ElasticityKind), else raise
+    InputError."""
+    return check_option(kind, KINDS, "kind")
 
 
 @dataclass(frozen=True)
@@ -37,13 +39,13 @@ class Material:
     def __post_init__(self):
         label = f" (material {self.name!r})" if self.name else ""
         if not (_real(self.E_Pa) and math.isfinite(self.E_Pa) and self.E_Pa > 0):
-            raise ValueError(
+            raise InputError(
                 f"E_Pa={self.E_Pa!r}{label}: Young's modulus must be finite and > 0 Pa")
         if not (_real(self.nu) and -1.0 < self.nu < 0.5):
-            raise ValueError(f"nu={self.nu!r}{label}: Poisson's ratio must satisfy -1 < nu < 0.5")
+            raise InputError(f"nu={self.nu!r}{label}: Poisson's ratio must satisfy -1 < nu < 0.5")
         if not (_real(self.rho_kg_m3) and math.isfinite(self.rho_kg_m3)
                 and self.rho_kg_m3 >= 0):
-            raise ValueError(
+            raise InputError(
                 f"rho_kg_m3={self.rho_kg_m3!r}{label}: density must be finite and >= 0 kg/m³")
 
     @property

@@ -25,7 +25,7 @@ normal. That is what node–node contact needs.
 """
 
 from ._gmsh import to_dolfinx
-from .tools import surface_nodes
+from .tools import surface_coordinates
 
 from .tags import (BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y,  # noqa: F401
                    UPPER)
@@ -33,5 +33,5 @@ from . import (bar_impact, block_on_base, hertz2d, hertz3d, oblique_impact, patc
                two_cylinders)
 
 __all__ = ["BASE", "UPPER", "FIXED", "LOADED", "SYMMETRY_X", "SYMMETRY_Y", "MASTER", "SLAVE",
-           "NAMES", "to_dolfinx", "surface_nodes", "bar_impact", "block_on_base", "hertz2d", "hertz3d",
+           "NAMES", "to_dolfinx", "surface_coordinates", "bar_impact", "block_on_base", "hertz2d", "hertz3d",
            "oblique_impact", "patch", "two_cylinders"]

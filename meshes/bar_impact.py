@@ -16,6 +16,7 @@ one-dimensional (each column of nodes shares one x).
 
 from . import _check, _gmsh
 from .tags import BASE, MASTER, NAMES, SLAVE, UPPER
+from flexcontact.errors import InputError
 
 TARGETS = ("wall", "bar")
 
@@ -35,9 +36,9 @@ def build(comm, length=1.0, height=0.05, n=50, ny=2, target="wall", wall=None):
     H = _check.positive("height", height)
     for name, value in (("n", n), ("ny", ny)):
         if not (isinstance(value, int) and value >= 1):
-            raise ValueError(f"{name}={value!r}: must be an integer >= 1")
+            raise InputError(f"{name}={value!r}: must be an integer >= 1")
     if target not in TARGETS:
-        raise ValueError(f"target={target!r}: must be one of {TARGETS}")
+        raise InputError(f"target={target!r}: must be one of {TARGETS}")
     h = L / n
     tw = _check.positive("wall", h if wall is None else wall)
     info = dict(length=L, height=H, n=n, ny=ny, h=h, target=target, wall=tw)

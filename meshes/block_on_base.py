@@ -16,6 +16,7 @@ import math
 
 from . import _check, _gmsh
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, UPPER
+from flexcontact.errors import InputError
 
 
 def _sizes(h, h_far, refine):
@@ -47,13 +48,13 @@ def build(comm, block=(0.1, 0.05), base=(0.3, 0.1), h=0.005, h_far=0.01, refine=
     bw, bh = (_check.positive(f"block[{i}]", v) for i, v in enumerate(block))
     Bw, Bd = (_check.positive(f"base[{i}]", v) for i, v in enumerate(base))
     if bw > Bw:
-        raise ValueError(f"block width {bw!r} exceeds base width {Bw!r}")
+        raise InputError(f"block width {bw!r} exceeds base width {Bw!r}")
     gap = _nonneg_gap(gap)
     h, hf = _sizes(h, h_far, refine)
     n = max(1, math.ceil(bw / h - 1e-9))  # interface segments
     x0, x1 = (-bw / 2, bw / 2) if patch is None else (float(patch[0]), float(patch[1]))
     if not -Bw / 2 < x0 < x1 < Bw / 2 and patch is not None:
-        raise ValueError(f"patch={patch!r}: need -base_width/2 < x0 < x1 < base_width/2 "
+        raise InputError(f"patch={patch!r}: need -base_width/2 < x0 < x1 < base_width/2 "
                          f"(base width {Bw!r})")
     hp = h * (1.0 if patch_spacing is None else
               _check.positive("patch_spacing", patch_spacing, "ratio"))
@@ -114,7 +115,7 @@ def build_3d(comm, block=(0.1, 0.1, 0.05), base=(0.3, 0.3, 0.1), h=0.01, h_far=0
     bx, by, bh = (_check.positive(f"block[{i}]", v) for i, v in enumerate(block))
     Bx, By, Bd = (_check.positive(f"base[{i}]", v) for i, v in enumerate(base))
     if bx > Bx or by > By:
-        raise ValueError(f"block footprint {(bx, by)!r} exceeds the base {(Bx, By)!r}")
+        raise InputError(f"block footprint {(bx, by)!r} exceeds the base {(Bx, By)!r}")
     gap = _nonneg_gap(gap)
     h, hf = _sizes(h, h_far, refine)
     info = dict(block=(bx, by, bh), base=(Bx, By, Bd), block_height=bh, base_depth=Bd, h=h,

@@ -23,6 +23,7 @@ from .dam_tags import (DAM, DAM_BASE, DAM_CREST, DAM_DOWNSTREAM, DAM_FLANKS, DAM
                        FOUNDATION, FOUNDATION_BOTTOM, FOUNDATION_FLANKS, FOUNDATION_SIDES, LOG,
                        LOG_BACK, LOG_FRONT, LOG_LOWER, LOG_MANTLE, LOG_UPPER, NAMES,
                        RESERVOIR_BED, TAILWATER_BED)
+from flexcontact.errors import InputError
 
 
 def build(comm, scenario):
@@ -216,10 +217,10 @@ def build_dam_only(comm, scenario, strip_m, water_levels_m=()):
     """
     s = scenario
     if s.dim != 2:
-        raise ValueError(f"dim={s.dim}: the dam mesh without the log is built in 2D only")
+        raise InputError(f"dim={s.dim}: the dam mesh without the log is built in 2D only")
     z0, z1 = (float(z) for z in strip_m)
     if not 0.0 < z0 < z1 < s.dam_height_m:
-        raise ValueError(f"strip_m={(z0, z1)}: need 0 < z0 < z1 < dam_height_m="
+        raise InputError(f"strip_m={(z0, z1)}: need 0 < z0 < z1 < dam_height_m="
                          f"{s.dam_height_m}")
     levels = sorted({float(z) for z in (*water_levels_m, s.water_level_m, z0, z1)
                      if 0.0 < z < s.dam_height_m}, reverse=True)

@@ -23,6 +23,7 @@ import numpy as np
 
 from . import _check, _gmsh
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, UPPER
+from flexcontact.errors import InputError
 
 
 def gap(x, R):
@@ -65,7 +66,7 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
     D = _check.positive("block_depth", 4 * R if block_depth is None else block_depth)
     _check.less("2R", 2 * R, "block_width", W)
     if h > w:
-        raise ValueError(
+        raise InputError(
             f"h_contact={h!r} (after refine={refine}) exceeds the zone half-width w={w!r}")
     hf = max(hf, h)
     near = 0.25 * w if fine_depth is None else _check.positive("fine_depth", fine_depth)

@@ -25,6 +25,7 @@ import numpy as np
 
 from . import _check, _gmsh
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y, UPPER
+from flexcontact.errors import InputError
 
 
 def gap(x, y, R):
@@ -61,7 +62,7 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
     H = _check.positive("column_height", R if column_height is None else column_height)
     gap_edge = R - math.sqrt(R * R - Rc * Rc)
     if H <= 2 * gap_edge:
-        raise ValueError(f"column_height={H!r} must exceed twice the sphere's rise at r = Rc "
+        raise InputError(f"column_height={H!r} must exceed twice the sphere's rise at r = Rc "
                          f"({2 * gap_edge!r} m) so that the mapped column is not inverted")
     Lx, Ly, D = (_check.positive(f"block[{i}]", v) for i, v in
                  enumerate((4 * R, 4 * R, 4 * R) if block is None else block))
@@ -71,7 +72,7 @@ def build(comm, R=0.05, a_expected=None, h_contact=None, h_far=None, refine=0,
     h = _check.positive("h_contact", a / 4 if h_contact is None else h_contact) / 2 ** refine
     hf = max(_check.positive("h_far", 0.4 * R if h_far is None else h_far) / 2 ** refine, h)
     if h > w:
-        raise ValueError(f"h_contact={h!r} (after refine={refine}) exceeds the zone radius w={w!r}")
+        raise InputError(f"h_contact={h!r} (after refine={refine}) exceeds the zone radius w={w!r}")
     z0 = H  # the column is meshed clear of the block, then mapped down
     info = dict(R=R, a_expected=a, w=w, h_contact=h, h_far=hf, column_radius=Rc,
                 column_height=H, block=(Lx, Ly, D))

@@ -16,6 +16,7 @@ import math
 
 from . import _check, _gmsh
 from .tags import BASE, FIXED, MASTER, NAMES, SLAVE, UPPER
+from flexcontact.errors import InputError
 
 
 def build(comm, R=0.05, h_contact=1e-3, h_far=None, zone=None, slide=None, gap=0.0,
@@ -44,7 +45,7 @@ def build(comm, R=0.05, h_contact=1e-3, h_far=None, zone=None, slide=None, gap=0
     _check.less("zone", w, "R", R)
     _check.less("zone + slide", w + s, "block_width / 2", W / 2)
     if not (math.isfinite(gap) and gap >= 0):
-        raise ValueError(f"gap={gap!r}: must be a finite number >= 0 m")
+        raise InputError(f"gap={gap!r}: must be a finite number >= 0 m")
     alpha = math.asin(w / R)
     info = dict(R=R, h_contact=h, h_far=hf, zone=w, slide=s, gap=float(gap), block_width=W,
                 block_depth=D, centre=(0.0, R + gap))

@@ -22,6 +22,7 @@ import math
 
 from . import _check, _gmsh
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, SYMMETRY_X, SYMMETRY_Y, UPPER
+from flexcontact.errors import InputError, SolveError
 
 PROGRESSION_2D = 1.15  # ratio of neighbouring interface segments in 2D (any value matches)
 NONMATCHING_RATIO = 1.5  # upper/lower interface segment counts (2D) or sizes (3D), non-matching
@@ -58,12 +59,12 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
     measure: w² in 3D, w in 2D) and n_contact_nodes (per surface).
     """
     if dim not in (2, 3) or isinstance(dim, bool):
-        raise ValueError(f"dim={dim!r}: must be 2 or 3")
+        raise InputError(f"dim={dim!r}: must be 2 or 3")
     if not isinstance(matching, bool):
-        raise ValueError(f"matching={matching!r}: must be True or False")
+        raise InputError(f"matching={matching!r}: must be True or False")
     cell = CELLS[dim][0] if cell is None else cell
     if cell not in CELLS[dim]:
-        raise ValueError(f"cell={cell!r}: in {dim}D must be one of {', '.join(CELLS[dim])}")
+        raise InputError(f"cell={cell!r}: in {dim}D must be one of {', '.join(CELLS[dim])}")
     w = _check.positive("width", width)
     H1 = _check.positive("lower_height", lower_height)
     H2 = _check.positive("upper_height", upper_height)
@@ -138,7 +139,7 @@ def build(comm, dim=3, width=0.1, lower_height=0.04, upper_height=0.06, h_lower=
         lower_vol = _gmsh.volumes_in(0, 0, -H1, w, w, 0)
         upper_vol = _gmsh.volumes_in(0, 0, 0, w, w, H2)
         if lower_vol != [lower] or upper_vol != [upper]:
-            raise RuntimeError(f"gmsh returned unexpected volumes {lower_vol}, {upper_vol}")
+            raise SolveError(f"gmsh returned unexpected volumes {lower_vol}, {upper_vol}")
         both = lower_vol + upper_vol
         master = _gmsh.faces_in(0, 0, 0, w, w, 0, lower_vol)
         slave = _gmsh.faces_in(0, 0, 0, w, w, 0, upper_vol)

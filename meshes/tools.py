@@ -3,7 +3,7 @@
 import numpy as np
 
 
-def surface_nodes(msh, facet_tags, tag: int) -> np.ndarray:
+def surface_coordinates(msh, facet_tags, tag: int) -> np.ndarray:
     """Coordinates (n, 3) in m of all vertices on facets tagged ``tag``, over all ranks.
 
     Collective. Every rank returns the same array, one row per distinct vertex (global

@@ -25,6 +25,7 @@ import numpy as np
 
 from . import _check, _gmsh
 from .tags import BASE, FIXED, LOADED, MASTER, NAMES, SLAVE, UPPER
+from flexcontact.errors import InputError
 
 
 def gap(x, R):
@@ -73,7 +74,7 @@ def build(comm, R1=0.05, R2=0.03, a_expected=None, h_contact=None, h_far=None, r
     hf = _check.positive("h_far", min(R1, R2) / 4 if h_far is None else h_far) / 2 ** refine
     ratio = _check.positive("spacing_ratio", spacing_ratio, "dimensionless")
     if max(h, ratio * h) > w:
-        raise ValueError(f"h_contact={h!r} (after refine={refine}, spacing_ratio={ratio!r}) "
+        raise InputError(f"h_contact={h!r} (after refine={refine}, spacing_ratio={ratio!r}) "
                          f"exceeds the zone half-width w={w!r}")
     hf = max(hf, h, ratio * h)
     x2, x1 = _zone_abscissae(w, h), _zone_abscissae(w, ratio * h)

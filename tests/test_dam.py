@@ -21,7 +21,7 @@ from flexcontact.dam.stage1 import solve_stage1, upstream_water_resultant
 from flexcontact.forms import Material
 from flexcontact.meshes import _gmsh
 from flexcontact.meshes import dam_tags as T
-from flexcontact.meshes.tools import surface_nodes
+from flexcontact.meshes.tools import surface_coordinates as surface_nodes
 
 COMM = MPI.COMM_WORLD
 RHO_W, G = 1000.0, 9.81

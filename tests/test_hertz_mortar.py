@@ -14,7 +14,7 @@ import pytest
 
 from demo_runner import A_TARGET, R_HERTZ, STEEL, assert_inputs, run_demo
 from flexcontact import analytic
-from flexcontact.interface import elliptic_fit
+from flexcontact.contact_profile import elliptic_fit
 
 REFINE = 2
 ESTAR = analytic.effective_modulus(STEEL["E_Pa"], STEEL["nu"], STEEL["E_Pa"], STEEL["nu"])

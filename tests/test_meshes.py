@@ -71,8 +71,8 @@ def test_tags_exist(built):
 def test_matching_interface_nodes_and_gap(built):
     name, msh, ct, ft, info, _ = built
     k = msh.topology.dim - 1  # tangential coordinates: x (2D), (x, y) (3D)
-    xm = meshes.surface_nodes(msh, ft, meshes.MASTER)
-    xs = meshes.surface_nodes(msh, ft, meshes.SLAVE)
+    xm = meshes.surface_coordinates(msh, ft, meshes.MASTER)
+    xs = meshes.surface_coordinates(msh, ft, meshes.SLAVE)
     assert len(xm) == len(xs) > 0
     j, offset = _pairs(xs, xm, k)
     scale = info.get("R", 0.1)
@@ -90,7 +90,7 @@ def test_serial_sizes(built):
     tdim = msh.topology.dim
     assert msh.topology.index_map(tdim).size_global == pytest.approx(cells, rel=0.1)
     assert msh.topology.index_map(0).size_global == pytest.approx(nodes, rel=0.1)
-    n_contact = len(meshes.surface_nodes(msh, ft, meshes.MASTER))
+    n_contact = len(meshes.surface_coordinates(msh, ft, meshes.MASTER))
     assert n_contact == info["n_contact_nodes"]
     if tdim == 2:
         assert n_contact == contact
@@ -129,9 +129,9 @@ def test_body_volumes(built):
 
 def test_hertz3d_symmetry_planes_and_flat_top():
     msh, ct, ft, info = meshes.hertz3d.build(COMM)
-    sx = meshes.surface_nodes(msh, ft, meshes.SYMMETRY_X)
-    sy = meshes.surface_nodes(msh, ft, meshes.SYMMETRY_Y)
-    top = meshes.surface_nodes(msh, ft, meshes.LOADED)
+    sx = meshes.surface_coordinates(msh, ft, meshes.SYMMETRY_X)
+    sy = meshes.surface_coordinates(msh, ft, meshes.SYMMETRY_Y)
+    top = meshes.surface_coordinates(msh, ft, meshes.LOADED)
     scale = info["R"]
     assert np.allclose(sx[:, 0], 0.0, atol=1e-12 * scale)
     assert np.allclose(sy[:, 1], 0.0, atol=1e-12 * scale)
@@ -179,8 +179,8 @@ def test_invalid_parameters(builder, kwargs, word):
 
 def test_block_on_base_with_gap():
     msh, ct, ft, info = meshes.block_on_base.build_3d(COMM, gap=1e-3, h=0.02, h_far=0.05)
-    xm = meshes.surface_nodes(msh, ft, meshes.MASTER)
-    xs = meshes.surface_nodes(msh, ft, meshes.SLAVE)
+    xm = meshes.surface_coordinates(msh, ft, meshes.MASTER)
+    xs = meshes.surface_coordinates(msh, ft, meshes.SLAVE)
     j, offset = _pairs(xs, xm, 2)
     assert len(xm) == len(xs) and offset.max() < 1e-14
     assert np.allclose(xs[:, 2] - xm[j, 2], 1e-3, atol=1e-15)
@@ -204,8 +204,8 @@ for name, build in [("hertz2d", meshes.hertz2d.build),
     msh, ct, ft, info = build(comm)
     tdim = msh.topology.dim
     k = tdim - 1
-    xm = meshes.surface_nodes(msh, ft, meshes.MASTER)
-    xs = meshes.surface_nodes(msh, ft, meshes.SLAVE)
+    xm = meshes.surface_coordinates(msh, ft, meshes.MASTER)
+    xs = meshes.surface_coordinates(msh, ft, meshes.SLAVE)
     d = np.linalg.norm(xs[:, None, :k] - xm[None, :, :k], axis=2).min(axis=1)
     owned = msh.topology.index_map(tdim).size_local
     out[name] = dict(cells=msh.topology.index_map(tdim).size_global,
@@ -237,7 +237,7 @@ def test_builders_under_mpirun_2(tmp_path):
         tdim = msh.topology.dim
         assert par[name]["cells"] == msh.topology.index_map(tdim).size_global, name
         assert par[name]["nodes"] == msh.topology.index_map(0).size_global, name
-        n = len(meshes.surface_nodes(msh, ft, meshes.MASTER))
+        n = len(meshes.surface_coordinates(msh, ft, meshes.MASTER))
         assert par[name]["master"] == par[name]["slave"] == n, name
         assert par[name]["offset"] <= 1e-12 * info.get("R", 0.1), name
         assert par[name]["distributed"] == 2, name  # both ranks own cells

@@ -14,7 +14,7 @@ from mpi4py import MPI
 import flexcontact as fc
 from demo_runner import A_TARGET, R_HERTZ, STEEL, assert_inputs, run_demo
 from flexcontact import analytic, compat, forms
-from flexcontact.interface import elliptic_fit
+from flexcontact.contact_profile import elliptic_fit
 from flexcontact.meshes import hertz2d, tags
 
 ESTAR_STEEL = analytic.effective_modulus(STEEL["E_Pa"], STEEL["nu"], STEEL["E_Pa"], STEEL["nu"])
@@ -61,12 +61,33 @@ def test_node_surface_equals_node_node_on_matching_meshes(matching):
 
 
 def test_curved_master_node_node_error_names_the_cause(matching):
-    # The block as slave against the curved cylinder with node–node pairs: the nodes do face
-    # each other, but not along the cylinder's normals. The message says so and names the
-    # pairing that works.
+    # The block as slave against the curved cylinder with node–node pairs asked for: the
+    # nodes do face each other, but not along the cylinder's normals. The message says so
+    # and names the pairing that works.
     msh, cells, facets, geo = matching
     with pytest.raises(ValueError, match=r"face each other one to one.*node_to_surface"):
-        _hertz2d_problem(msh, cells, facets, slave=tags.MASTER, master=tags.SLAVE)
+        _hertz2d_problem(msh, cells, facets, slave=tags.MASTER, master=tags.SLAVE,
+                         pairing="node_to_node")
+
+
+def test_auto_pairing_of_a_swapped_interface_falls_back_to_surface_to_surface(matching):
+    # The same swapped interface with the default pairing: node–node cannot pair it, so
+    # "auto" takes surface–surface, with no error. On these matching meshes each mortar row
+    # along the flat slave's normal joins a block node to the cylinder node straight above
+    # it with weight 1: the pairs of the interface the right way round, turned over, so the
+    # total normal force is the same to round-off (measured 3e-16 relative).
+    msh, cells, facets, geo = matching
+    force = {}
+    for name, (slave, master) in {"swapped": (tags.MASTER, tags.SLAVE),
+                                  "straight": (tags.SLAVE, tags.MASTER)}.items():
+        problem, top_y = _hertz2d_problem(msh, cells, facets, slave=slave, master=master)
+        top_y.value = -2e-6
+        inc = problem.step()
+        force[name] = inc.summary.normal_force
+        if name == "swapped":
+            assert problem.interfaces[0].pairing_used == "surface_to_surface"
+    assert force["straight"] > 0
+    assert abs(force["swapped"] / force["straight"] - 1) <= 1e-12, force
 
 
 def test_bad_pairing_name(matching):

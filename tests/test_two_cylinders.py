@@ -24,8 +24,8 @@ from mpi4py import MPI
 
 from demo_runner import ALUMINIUM, STEEL, assert_inputs, run_demo
 from flexcontact import analytic
-from flexcontact.interface import elliptic_fit
-from flexcontact.meshes import surface_nodes, tags, two_cylinders
+from flexcontact.contact_profile import elliptic_fit
+from flexcontact.meshes import surface_coordinates as surface_nodes, tags, two_cylinders
 
 REFINE = 2
 R1, R2 = 0.05, 0.03                     # the demo's default radii [m]

@@ -130,7 +130,7 @@ std::string report_repr(const SolveReport& r)
 void bind_errors(py::module& m)
 {
   static py::exception<ConvergenceError> convergence_error(m, "ConvergenceError",
-                                                           PyExc_RuntimeError);
+                                                           m.attr("SolveError"));
   py::register_exception_translator(
       [](std::exception_ptr p)
       {
@@ -150,6 +150,44 @@ void bind_errors(py::module& m)
       });
 }
 
+} // namespace
+
+py::handle flexcontact::bind_error_bases(py::module& m)
+{
+  // The classes live in Python (flexcontact/errors.py), so that the package's own errors
+  // and the compiled ones share one base; the module holds them for its lifetime.
+  py::module_ errors = py::module_::import("flexcontact.errors");
+  m.attr("SolveError") = errors.attr("SolveError");
+  m.attr("InputError") = errors.attr("InputError");
+  py::register_exception_translator(
+      [](std::exception_ptr p)
+      {
+        try
+        {
+          if (p)
+            std::rethrow_exception(p);
+        }
+        catch (const std::invalid_argument& e)
+        {
+          py::object cls = py::module_::import("flexcontact._cpp").attr("InputError");
+          PyErr_SetString(cls.ptr(), e.what());
+        }
+        catch (const std::runtime_error& e)
+        {
+          py::object cls = py::module_::import("flexcontact._cpp").attr("SolveError");
+          PyErr_SetString(cls.ptr(), e.what());
+        }
+        catch (const std::logic_error& e)
+        {
+          py::object cls = py::module_::import("flexcontact._cpp").attr("SolveError");
+          PyErr_SetString(cls.ptr(), e.what());
+        }
+      });
+  return m.attr("SolveError");
+}
+
+namespace
+{
 /// @brief problem.hpp: PairState, SolverOptions, SolveReport.
 void bind_problem(py::module& m)
 {

@@ -323,10 +323,10 @@ estimated_flops (RINFOG(1)), estimated_memory_mb (INFOG(17)), analysis_s, orderi
 void flexcontact::bind_petsc(py::module& m)
 {
   bind_schur_factor(m);
-  py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError",
-                                                 PyExc_RuntimeError);
-  py::register_exception<MumpsError>(m, "MumpsError", PyExc_RuntimeError);
-  py::register_exception<PetscError>(m, "PetscError", PyExc_RuntimeError);
+  py::handle base = m.attr("SolveError");
+  py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError", base);
+  py::register_exception<MumpsError>(m, "MumpsError", base);
+  py::register_exception<PetscError>(m, "PetscError", base);
 
   bind_distributed_schur(m);
   bind_flexibility(m);

@@ -2,7 +2,7 @@
 #pragma once
 
 /// @file contact_blocks.h
-/// @brief Per-body condensation (DESIGN.md §1): bodies share no DOFs and are coupled only
+/// @brief Per-body condensation (docs/architecture.md §7): bodies share no DOFs and are coupled only
 /// through contact, so K is block-diagonal by body (up to a permutation), and so are its
 /// Schur complement K*_cc on the contact DOFs and F* = (K*_cc)⁻¹. Each body's block is
 /// inverted on its own: the dense inverse costs Σ n_b³ instead of n_c³.

@@ -8,35 +8,36 @@ from __future__ import annotations
 
 import math
 import numbers
+from .errors import InputError
 
 
 def _number(name, value) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name}={value!r}: must be a real number")
+        raise InputError(f"{name}={value!r}: must be a real number")
     x = float(value)
     if not math.isfinite(x):
-        raise ValueError(f"{name}={value!r}: must be finite")
+        raise InputError(f"{name}={value!r}: must be finite")
     return x
 
 
 def _positive(name, value) -> float:
     x = _number(name, value)
     if x <= 0:
-        raise ValueError(f"{name}={value!r}: must be > 0")
+        raise InputError(f"{name}={value!r}: must be > 0")
     return x
 
 
 def _nonnegative(name, value) -> float:
     x = _number(name, value)
     if x < 0:
-        raise ValueError(f"{name}={value!r}: must be >= 0")
+        raise InputError(f"{name}={value!r}: must be >= 0")
     return x
 
 
 def _poisson(name, value) -> float:
     x = _number(name, value)
     if not -1.0 < x <= 0.5:
-        raise ValueError(f"{name}={value!r}: Poisson's ratio must satisfy -1 < nu <= 0.5")
+        raise InputError(f"{name}={value!r}: Poisson's ratio must satisfy -1 < nu <= 0.5")
     return x
 
 
@@ -76,7 +77,7 @@ def cattaneo_mindlin_stick_halfwidth(a_m, Q, mu, P):
     a, mu_, P_ = _positive("a_m", a_m), _positive("mu", mu), _positive("P", P)
     Q_ = _nonnegative("Q", Q)
     if Q_ > mu_ * P_:
-        raise ValueError(f"Q={Q!r}: exceeds mu*P = {mu_ * P_!r}; past mu*P the contact slides "
+        raise InputError(f"Q={Q!r}: exceeds mu*P = {mu_ * P_!r}; past mu*P the contact slides "
                          "and there is no stick zone")
     return a * math.sqrt(1 - Q_ / (mu_ * P_))
 
@@ -86,7 +87,7 @@ def cattaneo_mindlin_shear(x_m, a_m, c_m, mu, p0_Pa):
     x, a = _number("x_m", x_m), _positive("a_m", a_m)
     c = _nonnegative("c_m", c_m)
     if c > a:
-        raise ValueError(f"c_m={c_m!r}: the stick zone cannot be wider than a_m = {a_m!r}")
+        raise InputError(f"c_m={c_m!r}: the stick zone cannot be wider than a_m = {a_m!r}")
     mu_, p0 = _nonnegative("mu", mu), _nonnegative("p0_Pa", p0_Pa)
     q = mu_ * p0 * math.sqrt(max(0.0, 1 - (x / a) ** 2))
     if abs(x) < c:

@@ -11,6 +11,7 @@ import dolfinx.fem
 import dolfinx.fem.petsc
 
 from . import compat
+from .errors import InputError
 
 
 def assemble_stiffness(a_form, bcs: Sequence) -> PETSc.Mat:
@@ -40,6 +41,6 @@ def assemble_load(V, a_form, L_form: Optional[object], bcs: Sequence, comm) -> P
     compat.set_bc(p, list(bcs))
     if not comm.allreduce(bool(np.all(np.isfinite(p.array_r))), op=MPI.LAND):
         p.destroy()
-        raise ValueError("the load vector is not finite (check the loads and Dirichlet "
+        raise InputError("the load vector is not finite (check the loads and Dirichlet "
                          "values of this increment)")
     return p

@@ -8,6 +8,7 @@ import dolfinx.fem
 from petsc4py import PETSc
 
 from . import compat
+from .errors import InputError
 
 # DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never imported at run time.
 if TYPE_CHECKING:
@@ -31,14 +32,14 @@ def dirichlet(V: FunctionSpace, facet_tags: MeshTags, value: int,
         facet_tags.indices[facet_tags.values == value]
     from mpi4py import MPI
     if msh.comm.allreduce(len(facets), op=MPI.SUM) == 0:
-        raise ValueError(f"Dirichlet condition: no facet carries the tag value {value} "
+        raise InputError(f"Dirichlet condition: no facet carries the tag value {value} "
                          f"(values present: {sorted(set(np.unique(facet_tags.values).tolist()))})")
     comps = list(range(gdim)) if components is None else list(components)
     vals = np.broadcast_to(np.asarray(displacement_m, dtype=float), (len(comps),))
     bcs, consts = [], []
     for c, v in zip(comps, vals):
         if not 0 <= c < gdim:
-            raise ValueError(f"Dirichlet condition on tag {value}: component {c} does not "
+            raise InputError(f"Dirichlet condition on tag {value}: component {c} does not "
                              f"exist in {gdim}D")
         k = dolfinx.fem.Constant(msh, PETSc.ScalarType(v))
         dofs = compat.locate_component_dofs(V, c, facets)
@@ -56,7 +57,7 @@ def hold_body(V: FunctionSpace, cell_tags: MeshTags, value: int) -> list[Dirichl
     cells = cell_tags.indices[cell_tags.values == value]
     from mpi4py import MPI
     if msh.comm.allreduce(len(cells), op=MPI.SUM) == 0:
-        raise ValueError(f"hold_body: no cell carries the tag value {value}")
+        raise InputError(f"hold_body: no cell carries the tag value {value}")
     compat.create_connectivity(msh, tdim, tdim)  # DOLFINx 0.9 locates DOFs through it
     dofs = dolfinx.fem.locate_dofs_topological(V, tdim, cells)
     zero = np.zeros(msh.geometry.dim, dtype=PETSc.ScalarType)

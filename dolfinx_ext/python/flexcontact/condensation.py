@@ -15,6 +15,7 @@ from petsc4py import PETSc
 
 from . import _cpp, compat
 from .memory import check_dense_memory_collective
+from .mpi import raise_on_every_rank
 from .pairing import NodePairs
 
 
@@ -67,7 +68,8 @@ class Condensation:
         self.factorizations = 1
         self.n_contact_dofs = comm.bcast(self.dofs.size if root else None, root=0)
 
-        self.contact = self.B = self.W = self.x0 = self.frames = None
+        self.contact = None
+        self._cached = None
         if root:
             nv = self.n_virtual_dofs
             if nv:
@@ -77,7 +79,6 @@ class Condensation:
             build = kernel if kernel is not None else _cpp.CondensedContact
             self.contact = build(dim, F, pairs.x, kernel_pairs(pairs), mu, constrained, options)
             self.timings["delassus_s"] = time.perf_counter() - t0
-            self._operators()
 
     def _contact_scatter(self, K: PETSc.Mat, pairs, dim: int) -> None:
         """The contact DOFs (rank 0's list, empty elsewhere), the number of virtual ones
@@ -94,16 +95,63 @@ class Condensation:
         self._scatter = PETSc.Scatter().create(K.createVecLeft(), is_from, self._seq, is_to)
         self._template = K
 
-    def _operators(self):
-        c = self.contact
-        self.B, self.W, self.x0, self.frames = c.B, c.W, c.x0, c.frames
+    collective = False
+    """False: the kernel object lives on rank 0 alone (the factor path's is on every rank)."""
+
+    # B, W, x0 and the frames are the kernel object's, read once per pairing and flexibility
+    # (the bindings copy them) and forgotten when either changes: never a stale copy.
+    def _operator(self, name: str):
+        if self.contact is None:
+            return None
+        if self._cached is None:
+            self._cached = {}
+        if name not in self._cached:
+            self._cached[name] = getattr(self.contact, name)
+        return self._cached[name]
+
+    @property
+    def B(self):
+        """The gap operator B (SciPy sparse; rank 0, None elsewhere)."""
+        return self._operator("B")
+
+    @property
+    def W(self):
+        """W = B F* Bᵀ (rank 0, None elsewhere)."""
+        return self._operator("W")
+
+    @property
+    def x0(self):
+        """The initial gaps, pair-major in the local frames (rank 0, None elsewhere)."""
+        return self._operator("x0")
+
+    @property
+    def frames(self):
+        """(m, d, d) rows n, t₁[, t₂] of each pair (rank 0, None elsewhere)."""
+        return self._operator("frames")
 
     def set_pairs(self, pairs, mu: np.ndarray) -> None:
         """New pairs on the same contact nodes (rank 0): B, x0, W rebuilt from the stored F*,
         no factorization."""
         self.pairs = pairs
         self.contact.set_pairs(kernel_pairs(pairs), mu)
-        self._operators()
+        self._cached = None
+
+    def refactor(self, A: PETSc.Mat, method: str, ordering: str, dt_s: float,
+                 where: str) -> None:
+        """Factor ``A`` on the same contact DOFs and hand the kernel its flexibility
+        (``set_flexibility(F, dt_s)``: a new time step of an impact); the factor is replaced
+        only once the kernel accepted it. Collective."""
+        F, factor, info = _cpp.flexibility(A, self.dofs, method, ordering)
+        error = None
+        if self.comm.rank == 0:
+            try:
+                self.contact.set_flexibility(np.asarray(F), float(dt_s))
+            except ValueError as e:
+                error = f"{where}: {e}"
+        raise_on_every_rank(self.comm, error)
+        self.factor, self.flex_info = factor, dict(info)
+        self.factorizations += 1
+        self._cached = None
 
     def contact_values(self, up_c: np.ndarray) -> np.ndarray:
         """The values of all contact DOFs (rank 0): the gathered ``up_c`` of the real ones,

@@ -27,7 +27,7 @@ from __future__ import annotations
 import sys
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Callable, Optional, Sequence, Union
 
 import numpy as np
 import ufl
@@ -37,16 +37,20 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from . import _cpp, impact_setup as setup
-from ._cpp import ConvergenceError, SolverOptions
+from ._cpp import SolverOptions
 from .condensation import Condensation
 from .energy import EnergyAccount
 from .names import check_chain, check_flexibility_method, check_ordering
 from .pairing import pair_interfaces
 from .postprocess import ContactFields
+from .stepper import Stepper, StepperViews
+from .errors import InputError
 
 if TYPE_CHECKING:
-    from dolfinx.fem import DirichletBC
+    from dolfinx.fem import DirichletBC, FunctionSpace
     from dolfinx.mesh import MeshTags
+
+    from .output import ResultWriter
 
     from .problem import ContactInterface
 
@@ -73,7 +77,7 @@ class ImpactStepRecord:
     momentum: dict = field(default_factory=dict)  # body -> d components [N·s]
 
 
-class ImpactProblem:
+class ImpactProblem(StepperViews):
     """Dynamic frictional contact of elastic bodies by condensation (Moreau–Jean, θ = ½).
 
     Parameters
@@ -112,16 +116,18 @@ class ImpactProblem:
     ImpactStepRecord per step.
     """
 
-    def __init__(self, V, cell_tags: MeshTags, bodies: dict[str, int], materials: dict,
+    def __init__(self, V: FunctionSpace, cell_tags: MeshTags, bodies: dict[str, int], materials: dict,
                  bcs: Sequence[DirichletBC],
                  contact: Union[ContactInterface, Sequence[ContactInterface]], *,
                  dt_s: float, kind: str = "plane_stress",
                  initial_velocity: Optional[dict] = None, restitution: float = 0.0,
                  theta: float = 0.5, mass: str = "consistent",
-                 rayleigh: tuple[float, float] = (0.0, 0.0), loads=None,
+                 rayleigh: tuple[float, float] = (0.0, 0.0), loads: Optional[ufl.Form] = None,
                  solver: Optional[SolverOptions] = None, flexibility: str = "schur",
                  ordering: str = "auto", expected_contact_s: Optional[float] = None,
-                 initial_displacement=None, repair_pairs: bool = True, added_mass=None):
+                 initial_displacement: Optional[dolfinx.fem.Function] = None,
+                 repair_pairs: bool = True,
+                 added_mass: Optional[Callable[[ufl.Argument, ufl.Argument], ufl.Form]] = None):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)
@@ -137,7 +143,7 @@ class ImpactProblem:
         self.interfaces = list(contact) if isinstance(contact, (list, tuple)) else [contact]
         self.options = solver if solver is not None else SolverOptions()
         self.timings, self.records = {}, []
-        self.t, self.back_substitutions = 0.0, 0
+        self.t = 0.0
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
         dx = ufl.Measure("dx", domain=self.msh, subdomain_data=cell_tags)
         self.a_form = dolfinx.fem.form(forms.elasticity_form(u, v, materials, dx, kind,
@@ -152,12 +158,11 @@ class ImpactProblem:
         self.bodies = setup.make_bodies(V, cell_tags, bodies, materials, self.marker)
         self.pairs, self.mu, self.m = pair_interfaces(V, self.interfaces, self.comm)
         if any(i.rigid for i in self.interfaces):
-            raise ValueError("contact: a rigid target is not supported by ImpactProblem; "
+            raise InputError("contact: a rigid target is not supported by ImpactProblem; "
                              "mesh the obstacle and hold it with Dirichlet conditions")
         # Node–surface pairs follow the bodies: re-made before every step (``repair``).
         self.repairing = repair_pairs and any(i.pairing_used != "node_to_node"
                                               for i in self.interfaces)
-        self.pairings = 1
         self._check_time_step(expected_contact_s)
         self.K, self.M = setup.assemble_matrices(self.a_form, self.m_form, self.bcs, mass,
                                                  self.marker)
@@ -177,7 +182,7 @@ class ImpactProblem:
     def _check_time_step(self, expected_contact_s: Optional[float]) -> None:
         if expected_contact_s is not None:
             if not (setup._finite(expected_contact_s) and expected_contact_s > 0):
-                raise ValueError(f"expected_contact_s={expected_contact_s!r}: must be a "
+                raise InputError(f"expected_contact_s={expected_contact_s!r}: must be a "
                                  "finite number > 0 s")
             t_c, how = float(expected_contact_s), "given as expected_contact_s"
         else:
@@ -200,20 +205,26 @@ class ImpactProblem:
         def kernel(dim, F, X, kpairs, mu, constrained, options):
             return _cpp.ImpactContact(dim, F, X, kpairs, mu, e, dt, th, constrained, options)
 
-        self.condensation = Condensation(self.W_hat, self.bcs, self.pairs, self.mu, self.dim,
-                                         self.comm, self.options, flexibility, kernel=kernel,
-                                         ordering=self.ordering)
-        c = self.condensation
-        self.factor, self.flex_info = c.factor, c.flex_info
-        self.factorizations = 1
+        condensation = Condensation(self.W_hat, self.bcs, self.pairs, self.mu, self.dim,
+                                    self.comm, self.options, flexibility, kernel=kernel,
+                                    ordering=self.ordering)
+        self.stepper = Stepper(condensation, self.comm, expand_key="velocity_change_c",
+                               timings=self.timings)
         self.flexibility_method = flexibility
-        self._operators()
-        self.timings.update(c.timings)
+        self.timings.update(condensation.timings)
         self.timings["iteration_matrix_s"] = time.perf_counter() - t0
 
-    def _operators(self) -> None:
-        c = self.condensation
-        self.contact, self.B, self.W_eff = c.contact, c.B, c.W
+    # ---- what the stepper holds, read where it lives ----------------------------------
+    @property
+    def back_substitutions(self) -> int:
+        """Solves with the factor of Ŵ so far (a condensation and its expansion count as
+        one)."""
+        return self.stepper.back_substitutions
+
+    @property
+    def W_eff(self):
+        """W_eff = B F̂ Bᵀ (rank 0)."""
+        return self.stepper.operators()[1]
 
     def set_time_step(self, dt_s: float, expected_contact_s: Optional[float] = None) -> None:
         """Continue with the time step ``dt_s`` [s]: Ŵ = M + hθC + h²θ²K of the new h is
@@ -224,51 +235,29 @@ class ImpactProblem:
         old = self.expected_contact_s
         if expected_contact_s is not None:
             if not (setup._finite(expected_contact_s) and expected_contact_s > 0):
-                raise ValueError(f"expected_contact_s={expected_contact_s!r}: must be a "
+                raise InputError(f"expected_contact_s={expected_contact_s!r}: must be a "
                                  "finite number > 0 s")
             old = float(expected_contact_s)
         setup.check_resolution(float(dt_s), old, "the expected contact duration")
         t0 = time.perf_counter()
         W_hat = setup.iteration_matrix(self.K, self.M, float(dt_s), self.theta, self.rayleigh,
                                        self.marker)
-        F, factor, info = _cpp.flexibility(W_hat, self.condensation.dofs,
-                                           self.flexibility_method, self.ordering)
-        error = None
-        if self.comm.rank == 0:
-            try:
-                self.contact.set_flexibility(np.asarray(F), float(dt_s))
-            except ValueError as e:
-                error = f"set_time_step: {e}"
-        error = self.comm.bcast(error, root=0)
-        if error:
-            raise ValueError(error)
+        try:
+            self.stepper.set_flexibility(W_hat, self.flexibility_method, self.ordering,
+                                         float(dt_s), "set_time_step")
+        except ValueError:
+            W_hat.destroy()
+            raise
         self.W_hat.destroy()
-        self.W_hat, self.factor, self.flex_info = W_hat, factor, dict(info)
-        self.condensation.factor = factor
-        self.condensation.W = self.contact.W if self.comm.rank == 0 else None
+        self.W_hat = W_hat
         self.dt, self.expected_contact_s = float(dt_s), old
-        self.factorizations += 1
-        self._operators()
         self.timings.setdefault("refactor_s", []).append(time.perf_counter() - t0)
 
     def repair(self) -> None:
         """Re-make the node–surface pairs at the current positions x + u⁻: B, x0 and W_eff
         from the stored F̂, no factorization; each pair keeps its last impulse and state as
         the next step's warm start. Collective."""
-        c = self.condensation
-        uc = c.gather(self.u_vec)
-        error = None
-        if self.comm.rank == 0:
-            try:
-                self.pairs.repair(uc)
-                c.set_pairs(self.pairs, self.mu)
-            except ValueError as e:
-                error = f"time step {len(self.records) + 1}: re-pairing: {e}"
-        error = self.comm.bcast(error, root=0)
-        if error:
-            raise ValueError(error)
-        self._operators()
-        self.pairings += 1
+        self.stepper.repair(self.u_vec, self.mu, f"time step {len(self.records) + 1}")
 
     def _init_state(self, initial_velocity: Optional[dict], initial_displacement=None) -> None:
         self.u_vec = self.K.createVecLeft()
@@ -302,11 +291,7 @@ class ImpactProblem:
     def one_back_substitution(self) -> bool:
         """True when a time step is one back-substitution (the factor condenses and
         expands); False: the two-solve fallback (two solves in steps with contact)."""
-        return bool(getattr(self.factor, "has_condense", False))
-
-    def _solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
-        self.factor.solve(b, x)
-        self.back_substitutions += 1
+        return self.stepper.split
 
     def _step_rhs(self) -> PETSc.Vec:
         """r = h [f − C v⁻ − K (u⁻ + hθ v⁻)] in a work vector (overwritten by the next
@@ -324,79 +309,21 @@ class ImpactProblem:
             r.axpy(h, self.f)
         return r
 
-    def _free_velocity(self) -> PETSc.Vec:
-        """v_free = v⁻ + Ŵ⁻¹ h [f − C v⁻ − K (u⁻ + hθ v⁻)] (a full solve)."""
-        vfree = self.K.createVecLeft()
-        self._solve(self._step_rhs(), vfree)
-        vfree.axpy(1.0, self.v_vec)
-        return vfree
-
-    def _split_velocity(self) -> tuple[PETSc.Vec, Optional[dict]]:
-        """v⁺ and the kernel's step by one back-substitution: the step's right-hand side
-        condensed, the kernel's step from it, the expansion from its Δv_c."""
-        rc = self.factor.condense(self._step_rhs())
-        out = self._contact(rc, condensed=True)
-        root = self.comm.rank == 0
-        v_new = self.K.createVecLeft()
-        dv_c = np.asarray(out["velocity_change_c"]) if root else np.zeros(0)
-        self.factor.expand(dv_c, v_new)
-        self.back_substitutions += 1
-        v_new.axpy(1.0, self.v_vec)
-        return v_new, out
-
-    def _two_solve_velocity(self) -> tuple[PETSc.Vec, Optional[dict]]:
-        """v⁺ and the kernel's step with full solves: v_free, then, only when an impulse
-        acts, v⁺ = v_free + Ŵ⁻¹ Bᵀ P."""
-        vfree = self._free_velocity()
-        out = self._contact(self.condensation.gather(vfree), condensed=False)
-        root = self.comm.rank == 0
-        pushed = self.comm.bcast(bool(np.any(out["reaction"] != 0.0)) if root else None,
-                                 root=0)
-        if pushed:
-            r = self.condensation.reaction(out["reaction"] if root else None)
-            dv = self.K.createVecLeft()
-            self._solve(r, dv)
-            vfree.axpy(1.0, dv)
-            for o in (r, dv):
-                o.destroy()
-        return vfree, out
-
-    def _contact(self, b_or_vfree_c: Optional[np.ndarray], condensed: bool) -> Optional[dict]:
-        """The kernel's contact step on rank 0 (None elsewhere); errors on every rank.
-        ``b_or_vfree_c`` (rank 0): the condensed right-hand side when ``condensed``, else the
-        contact values of v_free."""
-        c = self.condensation
-        uc, vc = c.gather(self.u_vec), c.gather(self.v_vec)
-        out, failure = None, None
-        if self.comm.rank == 0:
-            try:
-                # the step's one crossing
-                step = self.contact.step_condensed if condensed else self.contact.step
-                out = step(uc, vc, np.asarray(b_or_vfree_c))
-            except ConvergenceError as e:
-                failure = (f"time step {len(self.records) + 1}: {e}",
-                           dict(getattr(e, "report", {})))
-            except ValueError as e:
-                failure = (f"time step {len(self.records) + 1}: {e}", None)
-        failure = self.comm.bcast(failure, root=0)
-        if failure:
-            if failure[1] is None:
-                raise ValueError(failure[0])
-            error = ConvergenceError(failure[0])
-            error.report = failure[1]
-            raise error
-        return out
-
     def step(self) -> ImpactStepRecord:
-        """Advance one time step of size dt_s."""
+        """Advance one time step of size dt_s: Δv = Ŵ⁻¹ (r + Bᵀ P) through the stepper (one
+        back-substitution with a factor that splits), v⁺ = v⁻ + Δv."""
         t0 = time.perf_counter()
         n_solves = self.back_substitutions
+        where = f"time step {len(self.records) + 1}"
         if self.repairing and self.records:
             self.repair()
-        if self.one_back_substitution:
-            v_new, out = self._split_velocity()
-        else:
-            v_new, out = self._two_solve_velocity()
+        c, root = self.condensation, self.comm.rank == 0
+        uc, vc = c.gather(self.u_vec), c.gather(self.v_vec)
+        v_new = self.K.createVecLeft()
+        out = self.stepper.advance(self._step_rhs(), v_new, where=where,
+                                   before=(uc, vc) if root else (),
+                                   free_shift=vc if root else None)
+        v_new.axpy(1.0, self.v_vec)
         du = self.K.createVecLeft()
         du.axpy(self.dt * self.theta, v_new)
         du.axpy(self.dt * (1.0 - self.theta), self.v_vec)
@@ -478,7 +405,7 @@ class ImpactProblem:
             f.x.array[:n] = vec.array_r
             f.x.scatter_forward()
 
-    def fields(self) -> list:
+    def fields(self) -> list[dolfinx.fem.Function]:
         """Output Functions (collective): displacement, velocity, contact pressure (mean over
         the last step, impulse / h / area), tangential traction, contact status (1 open,
         2 stick, 3 slip), von Mises."""
@@ -495,13 +422,13 @@ class ImpactProblem:
         f = self.outputs.all()
         return [f[0], self.velocity] + f[1:]
 
-    def run(self, t_end_s: float, writer=None, write_every: int = 1,
+    def run(self, t_end_s: float, writer: Optional[ResultWriter] = None, write_every: int = 1,
             progress: Optional[bool] = None) -> list[ImpactStepRecord]:
         """Steps until t_end_s; ``writer`` (a ResultWriter) gets the fields every
         ``write_every`` steps; a progress bar on rank 0 when ``progress`` (default: when
         stderr is a terminal)."""
         if not (setup._finite(t_end_s) and t_end_s > self.t):
-            raise ValueError(f"t_end_s={t_end_s!r}: must be finite and after t = {self.t:g} s")
+            raise InputError(f"t_end_s={t_end_s!r}: must be finite and after t = {self.t:g} s")
         n = int(round((t_end_s - self.t) / self.dt))
         bar = None
         if self.comm.rank == 0 and (progress or (progress is None and sys.stderr.isatty())):

@@ -20,24 +20,17 @@ from typing import Optional, Sequence
 import numpy as np
 from petsc4py import PETSc
 
-from . import _cpp, compat
-from ._cpp import ConvergenceError
-from .assembly import assemble_load
+from . import _cpp
 from .condensation import Condensation
 from .memory import working_set_bytes
-from .mpi import raise_on_every_rank
-from .postprocess import IncrementResult, record_increment
-
-CONTACT_OPERATORS = ("dense", "factor")
-
+from .names import CONTACT_OPERATORS, check_option
+from .errors import InputError
 
 def check_contact_operator(value, floating: bool) -> None:
     """A clear error for an unknown contact_operator, or one the options cannot use."""
-    if value not in CONTACT_OPERATORS:
-        raise ValueError(f"contact_operator={value!r}; it must be one of "
-                         f"{', '.join(map(repr, CONTACT_OPERATORS))}")
+    check_option(value, CONTACT_OPERATORS, "contact_operator")
     if value == "factor" and floating:
-        raise ValueError("contact_operator='factor' does not handle bodies held only by "
+        raise InputError("contact_operator='factor' does not handle bodies held only by "
                          "contact (floating=True); use contact_operator='dense'")
 
 
@@ -56,7 +49,8 @@ class FactorCondensation(Condensation):
     """The plain factor of K and the kernel's ``FactorContact`` (on every rank).
 
     Read as Condensation is: ``contact``, ``factor``, ``flex_info``, ``B``, ``x0``,
-    ``frames`` (rank 0), gather/reaction/contact_values; ``W`` is None (never formed).
+    ``frames`` (rank 0), gather/reaction/contact_values; ``W`` is None (never formed). The
+    stepper (stepper.py) drives it like the dense one, with every rank in the kernel step.
     """
 
     def __init__(self, K: PETSc.Mat, bcs: Sequence, pairs, mu: Optional[np.ndarray],
@@ -92,13 +86,16 @@ class FactorCondensation(Condensation):
                                           _kernel_pairs(arrays), mu, constrained, options,
                                           self.working_set_bytes)
         self.timings["delassus_s"] = time.perf_counter() - t0
-        self.W = None
-        self._operators()
+        self._cached = None
 
-    def _operators(self):
-        root = self.comm.rank == 0
-        c = self.contact
-        self.B, self.x0, self.frames = (c.B, c.x0, c.frames) if root else (None, None, None)
+    collective = True
+    """Every rank holds the kernel object and runs the same step."""
+
+    def _operator(self, name: str):
+        # W is never formed; B, x0 and the frames are read on rank 0, as on the dense path.
+        if name == "W" or self.comm.rank != 0:
+            return None
+        return super()._operator(name)
 
     def set_pairs(self, pairs, mu) -> None:
         """New pairs on the same contact nodes (rank 0's pairs and mu). Collective."""
@@ -107,64 +104,4 @@ class FactorCondensation(Condensation):
         arrays, mu = self.comm.bcast((_pair_arrays(pairs), np.asarray(mu)) if root else None,
                                      root=0)
         self.contact.set_pairs(_kernel_pairs(arrays), mu)
-        self._operators()
-
-
-def repair(pb) -> None:
-    """ContactProblem.repair for the factor path: every rank sets the new pairs."""
-    uc = pb.condensation.gather(compat.petsc_vec(pb.u))
-    error = None
-    if pb.comm.rank == 0:
-        try:
-            pb.pairs.repair(pb.condensation.contact_values(uc))
-        except ValueError as e:
-            error = f"increment {len(pb.increments) + 1}: re-pairing: {e}"
-    raise_on_every_rank(pb.comm, error)
-    c = pb.condensation
-    c.set_pairs(pb.pairs, pb.mu)
-    pb.B, pb.x0, pb.frames = c.B, c.x0, c.frames
-    pb.pairings += 1
-
-
-def step(pb) -> IncrementResult:
-    """ContactProblem.step for the factor path (same result, same errors)."""
-    t0 = time.perf_counter()
-    root = pb.comm.rank == 0
-    number = len(pb.increments) + 1
-    if pb.repairing:
-        repair(pb)
-    p = assemble_load(pb.V, pb.a_form, pb.L_form, pb.bcs, pb.comm)
-    up = pb.K.createVecRight()
-    pb.factor.solve(p, up)
-    upc = pb.condensation.gather(up)
-    upc = pb.comm.bcast(pb.condensation.contact_values(upc) if root else None, root=0)
-    out, failure = None, None
-    try:
-        t1 = time.perf_counter()
-        out = pb.contact.step(upc)  # collective: every rank runs the same iteration
-        pb.timings["last_contact_step_s"] = time.perf_counter() - t1
-    except ConvergenceError as err:
-        failure = (f"increment {number}: {err}", dict(getattr(err, "report", {})))
-    except ValueError as err:
-        failure = (f"increment {number}: {err}", None)
-    failure = pb.comm.bcast(failure, root=0)
-    if failure:
-        for v in (p, up):
-            v.destroy()
-        if failure[1] is None:
-            raise ValueError(failure[0])
-        error = ConvergenceError(failure[0])
-        error.report = failure[1]
-        raise error
-    r = pb.condensation.reaction(out["reaction"] if root else None)
-    r.axpy(1.0, p)
-    pb.factor.solve(r, compat.petsc_vec(pb.u))
-    pb.u.x.scatter_forward()
-    for v in (p, up, r):
-        v.destroy()
-    inc = record_increment(out if root else None, number, pb.u, pb.comm, pb.dim,
-                           time.perf_counter() - t0)
-    pb.increments.append(inc)
-    pb.outputs.write_back(inc, pb.pairs)
-    pb._guard_zone(inc)
-    return inc
+        self._cached = None

@@ -1,5 +1,5 @@
-"""Bodies held only by contact in a static problem (DESIGN.md §1, "Statics with a body that
-has rigid-body modes"), FETI style.
+"""Bodies held only by contact in a static problem (docs/architecture.md §1, the paragraph on a
+static body held only by contact), FETI style.
 
 Each such body's free rigid modes R come from its geometry (rigid_modes.py). A few
 *fixing DOFs* per body, chosen far from the contact surfaces and so that R restricted to
@@ -24,6 +24,7 @@ from petsc4py import PETSc
 from . import compat
 from ._cpp import ConvergenceError
 from .rigid_modes import FreeBody, free_body_text
+from .errors import InputError
 
 
 class NoEquilibriumError(ConvergenceError):
@@ -76,7 +77,7 @@ def _fixing_rows(body: FreeBody, V, contact_x: np.ndarray, held: np.ndarray, com
             rows = None
     rows = comm.bcast(rows, root=0)
     if rows is None:
-        raise ValueError(f"{free_body_text(body)}, and no DOFs of it away from the contact "
+        raise InputError(f"{free_body_text(body)}, and no DOFs of it away from the contact "
                          "surfaces can fix those modes (is the body only a contact surface?)")
     return np.asarray(rows, dtype=np.int64)
 
@@ -167,7 +168,7 @@ class FloatingBodies:
                          for b, j in self._columns() if not np.any(Rc[:, j])]
         untouched = self.comm.bcast(untouched, root=0)
         if untouched:
-            raise ValueError("the stiffness matrix is singular: " + "; ".join(untouched))
+            raise InputError("the stiffness matrix is singular: " + "; ".join(untouched))
 
     def _columns(self):
         """(body, first column) of each body."""

@@ -19,9 +19,11 @@ from petsc4py import PETSc
 import dolfinx.fem
 import dolfinx.fem.petsc
 
-from . import compat
+from . import compat, names
+from .names import check_option
+from .errors import InputError
 
-MASS_KINDS = ("lumped", "consistent")
+MASS_KINDS = names.MASS_KINDS
 MIN_STEPS_IN_CONTACT = 10
 """A time step must fit this many times into the expected contact duration."""
 
@@ -33,18 +35,17 @@ def _finite(x) -> bool:
 def check_scheme(dt_s, restitution, theta, mass, rayleigh) -> None:
     """ValueError naming the first bad scheme parameter."""
     if not (_finite(dt_s) and dt_s > 0):
-        raise ValueError(f"dt_s={dt_s!r}: the time step must be a finite number > 0 s")
+        raise InputError(f"dt_s={dt_s!r}: the time step must be a finite number > 0 s")
     if not (_finite(restitution) and 0.0 <= restitution <= 1.0):
-        raise ValueError(f"restitution={restitution!r}: Newton's coefficient of restitution "
+        raise InputError(f"restitution={restitution!r}: Newton's coefficient of restitution "
                          "must lie in [0, 1]")
     if not (_finite(theta) and 0.5 <= theta <= 1.0):
-        raise ValueError(f"theta={theta!r}: the θ-scheme needs 0.5 <= theta <= 1")
-    if mass not in MASS_KINDS:
-        raise ValueError(f"mass={mass!r}: must be one of {MASS_KINDS}")
+        raise InputError(f"theta={theta!r}: the θ-scheme needs 0.5 <= theta <= 1")
+    check_option(mass, MASS_KINDS, "mass")
     alpha, beta = rayleigh
     for name, value in (("alpha", alpha), ("beta", beta)):
         if not (_finite(value) and value >= 0):
-            raise ValueError(f"rayleigh {name}={value!r}: Rayleigh damping coefficients "
+            raise InputError(f"rayleigh {name}={value!r}: Rayleigh damping coefficients "
                              "must be finite and >= 0 (C = alpha M + beta K)")
 
 
@@ -79,7 +80,7 @@ def make_bodies(V, cell_tags, bodies: dict, materials: dict, held_marker: PETSc.
     """
     msh, comm = V.mesh, V.mesh.comm
     if not bodies:
-        raise ValueError("bodies={}: name at least one body {name: cell tag}")
+        raise InputError("bodies={}: name at least one body {name: cell tag}")
     bs = V.dofmap.index_map_bs
     n_owned = V.dofmap.index_map.size_local
     cell_blocks = compat.cell_dofs(V)
@@ -90,15 +91,15 @@ def make_bodies(V, cell_tags, bodies: dict, materials: dict, held_marker: PETSc.
     for name, tag in bodies.items():
         mat = materials.get(tag)
         if mat is None:
-            raise ValueError(f"body {name!r} (cell tag {tag}) has no material; materials are "
+            raise InputError(f"body {name!r} (cell tag {tag}) has no material; materials are "
                              f"given for the tags {sorted(materials)}")
         rho = mat.rho_kg_m3
         if not (_finite(rho) and rho > 0):
-            raise ValueError(f"body {name!r} (cell tag {tag}): density rho_kg_m3={rho!r}; "
+            raise InputError(f"body {name!r} (cell tag {tag}): density rho_kg_m3={rho!r}; "
                              "a body in an impact needs a density > 0 kg/m³ (it has no mass)")
         cells = cell_tags.indices[cell_tags.values == tag]
         if comm.allreduce(len(cells), op=MPI.SUM) == 0:
-            raise ValueError(f"body {name!r}: no cell carries the tag {tag}, so the body has "
+            raise InputError(f"body {name!r}: no cell carries the tag {tag}, so the body has "
                              "no mass")
         blocks = np.unique(cell_blocks[cells].reshape(-1))
         owned = blocks[blocks < n_owned]
@@ -136,7 +137,7 @@ def check_resolution(dt_s: float, t_contact_s: float, how: str) -> None:
         return
     if dt_s * MIN_STEPS_IN_CONTACT > t_contact_s:
         use = t_contact_s / MIN_STEPS_IN_CONTACT
-        raise ValueError(
+        raise InputError(
             f"dt_s={dt_s:g} cannot resolve the contact: the expected contact duration is "
             f"{t_contact_s:.3g} s ({how}), only {t_contact_s / dt_s:.2g} steps; use "
             f"dt_s <= {use:.3g} (at least {MIN_STEPS_IN_CONTACT} steps per contact)")
@@ -151,7 +152,7 @@ def held_marker(template: PETSc.Mat, bcs: Sequence) -> PETSc.Vec:
     worst = comm.allreduce(float(np.max(np.abs(g.array_r), initial=0.0)), op=MPI.MAX)
     g.destroy()
     if worst != 0.0:
-        raise ValueError(f"Dirichlet values up to {worst:g} m: the impact step holds supports "
+        raise InputError(f"Dirichlet values up to {worst:g} m: the impact step holds supports "
                          "fixed (zero displacement); prescribed motions are not supported")
     marker = template.createVecLeft()
     marker.set(1.0)
@@ -209,11 +210,11 @@ def initial_velocity(v: PETSc.Vec, bodies: Sequence[Body], velocities: dict,
     arr = v.array  # the owned values, writable in place
     for name, vel in (velocities or {}).items():
         if name not in names:
-            raise ValueError(f"initial_velocity names the body {name!r}; the bodies are "
+            raise InputError(f"initial_velocity names the body {name!r}; the bodies are "
                              f"{sorted(names)}")
         vel = np.asarray(vel, dtype=float).reshape(-1)
         if vel.size != gdim or not np.all(np.isfinite(vel)):
-            raise ValueError(f"initial_velocity[{name!r}]={vel.tolist()}: need {gdim} finite "
+            raise InputError(f"initial_velocity[{name!r}]={vel.tolist()}: need {gdim} finite "
                              "components in m/s")
         for c, dofs in enumerate(names[name].dofs):
             arr[dofs] = vel[c]
@@ -227,11 +228,11 @@ def initial_displacement(u: PETSc.Vec, u0, V, marker: PETSc.Vec) -> None:
     owned = None if x is None else u0.function_space.dofmap.index_map.size_local * \
         u0.function_space.dofmap.index_map_bs
     if owned != n:
-        raise ValueError(f"initial_displacement={u0!r}: must be a Function on the problem's "
+        raise InputError(f"initial_displacement={u0!r}: must be a Function on the problem's "
                          f"vector space V ({n} owned values on this rank, got {owned})")
     vals = x.array[:n]
     if not np.all(np.isfinite(vals)):
-        raise ValueError("initial_displacement has non-finite values")
+        raise InputError("initial_displacement has non-finite values")
     u.array[:] = vals
     u.pointwiseMult(u, marker)
 
@@ -246,19 +247,14 @@ def load_vector(V, L_form, bcs: Sequence) -> Optional[PETSc.Vec]:
     return f
 
 
-def unloaded_free_velocity(K: PETSc.Mat, factor, h: float, theta: float, w: PETSc.Vec,
-                           omega: PETSc.Vec) -> PETSc.Vec:
-    """v_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)]: the free velocity of a body with no load and no
-    damping, from its displacement w and velocity ω (one back-substitution with the stored
-    factor of Ŵ)."""
+def unloaded_step_rhs(K: PETSc.Mat, h: float, theta: float, w: PETSc.Vec,
+                      omega: PETSc.Vec) -> PETSc.Vec:
+    """h[−K (w + hθ ω)]: the right-hand side of a θ-step of a body with no load and no
+    damping, from its displacement w and velocity ω (a new Vec); Δv = Ŵ⁻¹ of it."""
     y = w.copy()
     y.axpy(h * theta, omega)
     r = K.createVecLeft()
     K.mult(y, r)
     r.scale(-h)
-    out = K.createVecLeft()
-    factor.solve(r, out)
-    out.axpy(1.0, omega)
-    for o in (y, r):
-        o.destroy()
-    return out
+    y.destroy()
+    return r

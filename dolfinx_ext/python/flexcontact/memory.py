@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 from typing import Optional
+from .errors import FlexcontactError, InputError
 
 ENV_AVAILABLE = "FLEXCONTACT_AVAILABLE_MEMORY_GB"
 
@@ -22,7 +23,7 @@ FSTAR_COPIES = 4
 W_COPIES = 4
 
 
-class ContactMemoryError(MemoryError):
+class ContactMemoryError(FlexcontactError, MemoryError):
     """The dense condensed contact problem would not fit in the memory available.
 
     ``needed_bytes``, ``available_bytes``, ``n_contact_dofs`` and ``pairs`` hold the numbers
@@ -53,9 +54,9 @@ def _env_gb(name: str, zero_allowed: bool) -> Optional[float]:
     try:
         value = float(env)
     except ValueError:
-        raise ValueError(f"{name}={env!r}; it must be a number of GB") from None
+        raise InputError(f"{name}={env!r}; it must be a number of GB") from None
     if not (value >= 0 if zero_allowed else value > 0):
-        raise ValueError(f"{name}={env!r}; it must be "
+        raise InputError(f"{name}={env!r}; it must be "
                          + ("≥ 0 GB" if zero_allowed else "a positive number of GB"))
     return value * 1e9
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from .projection import facet_normals
+from .errors import InputError
 
 ILL_CONDITIONED = 1e10   # condition number of M_e beyond which ψ_a = N_a is used
 _BATCH = 4_000_000       # slave × master facet tests per candidate batch
@@ -223,7 +224,7 @@ def mortar_rows_3d(Xs, slave_facets, slave_ref, Xm, master_facets, master_ref, c
     facet's corners are on average within ``cutoff_m`` of the slave facet's plane."""
     for side, f in (("slave", slave_facets), ("master", master_facets)):
         if f.ndim != 2 or f.shape[1] not in _PERIMETER:
-            raise ValueError(f"pairing='surface_to_surface' in 3D needs triangle or "
+            raise InputError(f"pairing='surface_to_surface' in 3D needs triangle or "
                              f"quadrilateral facets; the {side} facets have "
                              f"{f.shape[-1] if f.ndim == 2 else f.shape} vertices")
     nvs, nvm = slave_facets.shape[1], master_facets.shape[1]

@@ -4,9 +4,11 @@ from __future__ import annotations
 import time
 from typing import Optional, Union
 
+from .errors import InputError
+
 
 def raise_on_every_rank(comm, error: Optional[Union[str, BaseException]],
-                        kind: type = ValueError) -> None:
+                        kind: Optional[type] = None) -> None:
     """Raise on every rank what rank 0 found wrong; do nothing if it found nothing.
 
     Checks made on rank 0 alone (where the gathered data lives) must fail on all ranks, or
@@ -16,14 +18,14 @@ def raise_on_every_rank(comm, error: Optional[Union[str, BaseException]],
         comm: the communicator (mpi4py).
         error: rank 0's finding: None (all is well), a message, or an exception to re-raise.
             Other ranks' values are ignored.
-        kind: the exception type raised for a message.
+        kind: the exception type raised for a message (default InputError, a ValueError).
     """
     error = comm.bcast(error, root=0)
     if error is None or error == "":
         return
     if isinstance(error, BaseException):
         raise error
-    raise kind(error)
+    raise (kind or InputError)(error)
 
 
 def wait_for_root(comm, poll_s: float = 2e-4) -> None:

@@ -1,11 +1,16 @@
-"""The names users pass as strings: flexibility methods and local contact solvers.
+"""The names users pass as strings, all in one place: flexibility methods, orderings, local
+contact solvers, pairings, contact operators, zone-edge actions, elasticity kinds, mass
+kinds and rigid-target kinds.
 
 They are checked in Python, before any assembly or factorization, so that a typo fails at
-once with the list of accepted names instead of minutes later inside the C++ layer.
+once with the list of accepted names instead of minutes later inside the C++ layer; every
+check raises an InputError (a ValueError) naming the parameter, its value and the choices.
 """
 from __future__ import annotations
 
 from typing import Iterable, Literal, get_args
+
+from .errors import InputError
 
 FlexibilityMethod = Literal["schur", "inverse_entries", "matmatsolve"]
 """How F* = (K⁻¹)_cc is computed: MUMPS Schur complement (on several ranks from MUMPS driven
@@ -26,15 +31,50 @@ SolverName = Literal["newton_ac", "active_set", "projection"]
 """Local contact solvers of ``SolverOptions.chain``: semi-smooth Newton on Alart–Curnier,
 the Feng–Touzot active set, the De Saxcé–Feng projection."""
 
+Pairing = Literal["auto", "node_to_node", "node_to_surface", "surface_to_surface"]
+"""How a contact interface pairs its surfaces (docs/architecture.md §4): "auto" is
+node–node where the surfaces' nodes match one to one, surface–surface otherwise."""
+
+ContactOperator = Literal["dense", "factor"]
+"""W formed densely, or never formed: the working set through the factor of K."""
+
+ZoneEdgeAction = Literal["warn", "error", "ignore"]
+"""What contact reaching the open edge of a tagged candidate surface does."""
+
+ElasticityKind = Literal["plane_strain", "plane_stress", "3d"]
+"""The elasticity model of a form."""
+
+MassKind = Literal["lumped", "consistent"]
+"""The mass matrix of an impact: row-sum lumped or consistent."""
+
+RigidKind = Literal["plane", "circle", "sphere"]
+"""The shape of a rigid target."""
+
 FLEXIBILITY_METHODS: tuple[str, ...] = get_args(FlexibilityMethod)
 ORDERINGS: tuple[str, ...] = get_args(Ordering)
 SOLVER_NAMES: tuple[str, ...] = get_args(SolverName)
+PAIRINGS: tuple[str, ...] = get_args(Pairing)
+CONTACT_OPERATORS: tuple[str, ...] = get_args(ContactOperator)
+ZONE_EDGE_ACTIONS: tuple[str, ...] = get_args(ZoneEdgeAction)
+ELASTICITY_KINDS: tuple[str, ...] = get_args(ElasticityKind)
+MASS_KINDS: tuple[str, ...] = get_args(MassKind)
+RIGID_KINDS: tuple[str, ...] = get_args(RigidKind)
+
+
+def check_option(value, choices: tuple[str, ...], name: str, where: str = "") -> str:
+    """``value`` itself if it is one of ``choices``; an InputError reading
+    "<where>: <name>='value'; it must be one of 'a', 'b'" otherwise."""
+    if not isinstance(value, str) or value not in choices:
+        head = f"{where}: " if where else ""
+        raise InputError(f"{head}{name}={value!r}; it must be one of "
+                         f"{', '.join(map(repr, choices))}")
+    return value
 
 
 def check_flexibility_method(method: str) -> FlexibilityMethod:
     """``method`` itself if it is a flexibility method; ValueError naming it otherwise."""
     if method not in FLEXIBILITY_METHODS:
-        raise ValueError(f"unknown flexibility method {method!r}; "
+        raise InputError(f"unknown flexibility method {method!r}; "
                          f"allowed: {', '.join(FLEXIBILITY_METHODS)}")
     return method
 
@@ -42,7 +82,7 @@ def check_flexibility_method(method: str) -> FlexibilityMethod:
 def check_ordering(ordering: str) -> Ordering:
     """``ordering`` itself if it is a factorization ordering; ValueError naming it otherwise."""
     if ordering not in ORDERINGS:
-        raise ValueError(f"unknown ordering {ordering!r}; allowed: {', '.join(ORDERINGS)}")
+        raise InputError(f"unknown ordering {ordering!r}; allowed: {', '.join(ORDERINGS)}")
     return ordering
 
 
@@ -51,6 +91,6 @@ def check_chain(chain: Iterable[str]) -> list[SolverName]:
     names = list(chain)
     for name in names:
         if name not in SOLVER_NAMES:
-            raise ValueError(f"unknown contact solver {name!r} in the chain; "
+            raise InputError(f"unknown contact solver {name!r} in the chain; "
                              f"allowed: {', '.join(SOLVER_NAMES)}")
     return names

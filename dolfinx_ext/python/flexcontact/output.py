@@ -12,6 +12,7 @@ from mpi4py import MPI
 
 from .xdmf import XdmfSeries
 from .xdmf_gather import MeshGather, raise_on_any_rank
+from .errors import InputTypeError
 
 # DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never imported at run time.
 if TYPE_CHECKING:
@@ -116,7 +117,7 @@ def write_summary(folder: Union[str, os.PathLike], data: dict,
             return o.tolist()
         if hasattr(o, "__dataclass_fields__"):
             return asdict(o)
-        raise TypeError(f"cannot write {type(o)} to JSON")
+        raise InputTypeError(f"cannot write {type(o)} to JSON")
 
     tmp = folder / "summary.json.tmp"
     tmp.write_text(json.dumps(data, indent=2, default=plain))

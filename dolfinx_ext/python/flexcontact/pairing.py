@@ -8,6 +8,7 @@ of a pair is n · (X_s − X_m) ≥ 0 when the bodies are apart.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
@@ -16,11 +17,14 @@ import numpy as np
 from . import compat
 from .surface import surface_nodes
 from .surface_pairs import build_surface_pairs, slave_edge_flags
+from . import names
+from .mesh_bodies import body_labels
 from .mpi import raise_on_every_rank
 from .zone import open_edge_flags
+from .errors import InputError
 
 
-class NonMatchingError(ValueError):
+class NonMatchingError(InputError):
     """The two contact surfaces have no matching nodes (counts differ, or nodes do not face
     each other one to one in any direction): a mesh property, not a set-up error."""
 
@@ -85,7 +89,7 @@ def match_nodes(slave: dict, master: dict, tolerance: float, label: str = "") ->
             f"surface {nm}; node–node pairing needs matching interface nodes; use "
             f"pairing='surface_to_surface' or 'node_to_surface' for non-matching meshes")
     if ns == 0:
-        raise ValueError(f"node–node contact{where}: the contact surfaces have no nodes")
+        raise InputError(f"node–node contact{where}: the contact surfaces have no nodes")
     normals = np.asarray(master["normal"])
     partner = np.empty(ns, dtype=np.int64)
     offset = np.empty(ns)
@@ -145,7 +149,7 @@ def _unmatched_message(xs, ns, xm, offset, worst, tolerance, where) -> tuple[str
 
 # "auto": node–node where the surfaces' nodes match, surface–surface (the pairing that passes
 # the patch test on non-matching meshes) where they do not.
-PAIRINGS = ("auto", "node_to_node", "node_to_surface", "surface_to_surface")
+PAIRINGS = names.PAIRINGS
 
 
 def pair_interfaces(V, interfaces: Sequence, comm):
@@ -161,13 +165,14 @@ def pair_interfaces(V, interfaces: Sequence, comm):
     msh = V.mesh
     compat.create_connectivity(msh, msh.topology.dim - 1, msh.topology.dim)
     root = comm.rank == 0
-    parts, mus, error = [], [], None
+    parts, mus, error, surfaces = [], [], None, []
     for itf in interfaces:
         rigid = not isinstance(itf.master, (int, np.integer))
         kind = "rigid" if rigid else getattr(itf, "pairing", "node_to_node")
         # Collective: every rank takes part even after an error on rank 0.
         s = _candidate_surface(V, itf.facet_tags, itf.slave)
         m = itf.master if rigid else _candidate_surface(V, itf.facet_tags, itf.master)
+        surfaces.append((s, None if rigid else m))
         if root and error is None:
             try:
                 kind, other = _resolve(kind, s, m, itf, V.mesh.geometry.dim)
@@ -186,12 +191,60 @@ def pair_interfaces(V, interfaces: Sequence, comm):
         pairs.interface = np.concatenate([np.full(p.m, i) for i, (_, _, p) in
                                           enumerate(parts)])
     raise_on_every_rank(comm, error)
+    _check_bodies(V, interfaces, surfaces, comm)
     kinds = comm.bcast([k for k, _, _ in parts] if root else None, root=0)
     for itf, kind in zip(interfaces, kinds):
         itf.pairing_used = kind   # what "auto" chose (and "rigid" for rigid targets)
     pairs = pairs if root else None
     mu = np.concatenate(mus) if root else np.zeros(0)
     return pairs, mu, comm.bcast(pairs.m if root else None, root=0)
+
+
+class SelfContactWarning(UserWarning):
+    """A contact interface's master surface lies on the slave's own body, as asked
+    (``ContactInterface(self_contact=True)``)."""
+
+
+def _check_bodies(V, interfaces: Sequence, surfaces: list, comm) -> None:
+    """ValueError naming both tags when an interface's master surface lies on the slave's
+    own body (a boundary tag mixed up with the master tag), or a SelfContactWarning where
+    the interface says a self-contact is meant. Collective."""
+    bs = V.dofmap.index_map_bs
+    root = comm.rank == 0
+    blocks, spans = [], []
+    if root:
+        for s, m in surfaces:
+            if m is None:
+                spans.append(None)
+                continue
+            a = np.asarray(s["dofs"])[:, 0] // bs
+            b = np.asarray(m["dofs"])[:, 0] // bs
+            spans.append((len(blocks), a.size, b.size))
+            blocks.extend(a.tolist())
+            blocks.extend(b.tolist())
+    labels = body_labels(V, np.asarray(blocks, dtype=np.int64) if root else None)
+    error, same = None, []
+    if root:
+        for itf, span in zip(interfaces, spans):
+            if span is None:
+                continue
+            start, ns, nm = span
+            shared = np.intersect1d(labels[start:start + ns], labels[start + ns:start + ns + nm])
+            if shared.size == 0:
+                continue
+            if getattr(itf, "self_contact", False):
+                same.append(itf.label)
+                continue
+            error = (f"contact interface {itf.label}: the master surface (facet tag "
+                     f"{itf.master}) lies on the same body as the slave surface (facet tag "
+                     f"{itf.slave}): the mesh connects their nodes. A boundary tag may have "
+                     "been given as the master; contact needs the tag of the other body's "
+                     "surface. For a body touching itself, pass self_contact=True")
+            break
+    raise_on_every_rank(comm, error)
+    for label in same:
+        warnings.warn(f"contact interface {label}: self-contact: the master surface lies on "
+                      "the slave's own body", SelfContactWarning, stacklevel=4)
 
 
 def _candidate_surface(V, facet_tags, value: int) -> dict:
@@ -210,7 +263,10 @@ def _resolve(kind: str, s: dict, m, itf, dim: int):
     if kind == "auto":
         try:
             return "node_to_node", _node_pairs(s, m, itf)
-        except NonMatchingError:
+        except ValueError:
+            # Any surfaces node–node cannot pair (counts differ, nodes off the master's
+            # normals as when slave and master are swapped on a curved surface):
+            # surface–surface pairs them, or says itself why it cannot.
             return "surface_to_surface", m
     if kind == "node_to_node":
         return kind, _node_pairs(s, m, itf)

@@ -17,6 +17,7 @@ import dolfinx.fem
 from . import compat
 from .writeback import set_nodal_values
 from .pairing import NodePairs
+from .errors import SolveError
 
 STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
 
@@ -135,7 +136,7 @@ class ContactFields:
         same = nQ == nV and np.allclose(Q.tabulate_dof_coordinates()[:nQ],
                                         V.tabulate_dof_coordinates()[:nV])
         if not comm.allreduce(same, op=MPI.LAND):
-            raise RuntimeError("scalar and vector P1 spaces number their nodes differently; "
+            raise SolveError("scalar and vector P1 spaces number their nodes differently; "
                                "contact fields cannot be written back")
         self.von_mises = None
         if stress is not None:

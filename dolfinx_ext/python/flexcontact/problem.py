@@ -21,36 +21,38 @@ import numpy as np
 import dolfinx.fem
 
 from . import compat
-from ._cpp import ConvergenceError, SolverOptions
+from ._cpp import SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
 from . import factor_path
-from .mpi import raise_on_every_rank, wait_for_root
-from .names import FlexibilityMethod, Ordering, check_chain, check_flexibility_method, \
-    check_ordering
-from .pairing import PAIRINGS, pair_interfaces
+from .stepper import Stepper, StepperViews
+from .names import (PAIRINGS, ZONE_EDGE_ACTIONS, ContactOperator, FlexibilityMethod, Ordering,
+                    Pairing, ZoneEdgeAction, check_chain, check_flexibility_method,
+                    check_option, check_ordering)
+from .pairing import pair_interfaces
 from .postprocess import (STATE_NAMES, ContactFields, IncrementResult,  # noqa: F401
                           IncrementSummary, record_increment)
 from .rigid import RigidTarget
 from .floating import FloatingBodies, NoEquilibriumError, TippingWarning
 from .rigid_modes import check_bodies, free_bodies
+from .errors import FlexcontactError, InputError, InputTypeError
 
 # Annotations use DOLFINx 0.9's class names; 0.5 spells them *MetaClass, so never at run time.
 if TYPE_CHECKING:
     import ufl
     from dolfinx.fem import DirichletBC
     from dolfinx.mesh import MeshTags
-    from petsc4py import PETSc
+
+    from .output import ResultWriter
 
 
-ZONE_EDGE_ACTIONS = ("warn", "error", "ignore")
 
 
 class ContactZoneWarning(UserWarning):
     """Contact reached the edge of a tagged candidate surface (see zone.py)."""
 
 
-class ContactZoneError(RuntimeError):
+class ContactZoneError(FlexcontactError, RuntimeError):
     """Contact reached the edge of a tagged candidate surface and the interface asked for
     an error (``zone_edge="error"``); the increment is recorded before it is raised."""
 
@@ -64,7 +66,7 @@ class ContactInterface:
     target surface, or a RigidTarget (rigid.py: a plane, circle or sphere with no DOFs).
     The master's outward normal defines the local frame.
 
-    ``pairing`` chooses the model for two tagged surfaces (DESIGN.md §2):
+    ``pairing`` chooses the model for two tagged surfaces (docs/architecture.md §4):
 
     * "auto" (default): "node_to_node" when the two surfaces' nodes match one to one, else
       "surface_to_surface" (the pairing that passes the contact patch test on non-matching
@@ -90,6 +92,10 @@ class ContactInterface:
     open edge of a candidate surface (zone.py): "warn" (a ContactZoneWarning), "error"
     (ContactZoneError after the increment is recorded) or "ignore"; the increment summary
     lists the interface in ``zone_edge`` either way.
+
+    A master surface on the slave's own body (the mesh connects their nodes) is refused with
+    an error naming both tags, as it is almost always a boundary tag given as the master;
+    ``self_contact=True`` says a body touching itself is meant (a SelfContactWarning then).
     """
 
     facet_tags: MeshTags
@@ -98,22 +104,23 @@ class ContactInterface:
     mu: float
     tolerance_m: Optional[float] = None
     name: str = ""
-    pairing: str = "auto"
-    zone_edge: str = "warn"
+    pairing: Pairing = "auto"
+    zone_edge: ZoneEdgeAction = "warn"
+    self_contact: bool = False
 
     def __post_init__(self):
         self.mu = _friction_coefficient(self.mu, self.label)
-        if self.pairing not in PAIRINGS:
-            raise ValueError(f"contact interface {self.label}: pairing={self.pairing!r}; it "
-                             f"must be one of {', '.join(map(repr, PAIRINGS))}")
-        if self.zone_edge not in ZONE_EDGE_ACTIONS:
-            raise ValueError(f"contact interface {self.label}: zone_edge={self.zone_edge!r};"
-                             f" it must be one of {', '.join(map(repr, ZONE_EDGE_ACTIONS))}")
+        where = f"contact interface {self.label}"
+        check_option(self.pairing, PAIRINGS, "pairing", where)
+        check_option(self.zone_edge, ZONE_EDGE_ACTIONS, "zone_edge", where)
+        if not isinstance(self.self_contact, (bool, np.bool_)):
+            raise InputError(f"{where}: self_contact={self.self_contact!r}; it must be True "
+                             "or False")
         if not isinstance(self.master, (int, np.integer, RigidTarget)):
-            raise TypeError(f"contact interface {self.label}: master={self.master!r}; it "
+            raise InputTypeError(f"contact interface {self.label}: master={self.master!r}; it "
                             "must be a facet tag value or a RigidTarget")
         if self.slave == self.master:
-            raise ValueError(f"contact interface {self.label}: slave and master are the same "
+            raise InputError(f"contact interface {self.label}: slave and master are the same "
                              f"tag ({self.slave})")
 
     @property
@@ -138,12 +145,12 @@ def _friction_coefficient(mu, label: str) -> float:
                 and not np.issubdtype(arr.dtype, np.complexfloating):
             value = float(arr)
     if value is None or not math.isfinite(value) or value < 0:
-        raise ValueError(f"contact interface {label}: friction coefficient mu={mu!r}; "
+        raise InputError(f"contact interface {label}: friction coefficient mu={mu!r}; "
                          "it must be a finite real number ≥ 0 (a Python or NumPy scalar)")
     return value
 
 
-class ContactProblem:
+class ContactProblem(StepperViews):
     """Static contact of deformable bodies with Coulomb friction, by condensation.
 
     Parameters
@@ -200,18 +207,18 @@ class ContactProblem:
                  stress: Optional[Callable] = None, solver: Optional[SolverOptions] = None,
                  flexibility: FlexibilityMethod = "schur", ordering: Ordering = "auto",
                  repair_pairs: bool = True, floating: bool = False,
-                 contact_operator: str = "dense"):
+                 contact_operator: ContactOperator = "dense"):
         check_flexibility_method(flexibility)
         factor_path.check_contact_operator(contact_operator, floating)
         self.contact_operator = contact_operator
         if not isinstance(repair_pairs, (bool, np.bool_)):
-            raise ValueError(f"repair_pairs={repair_pairs!r}; it must be True or False")
+            raise InputError(f"repair_pairs={repair_pairs!r}; it must be True or False")
         check_ordering(ordering)
         if solver is not None:
             check_chain(solver.chain)
         self.interfaces = list(contact) if isinstance(contact, (list, tuple)) else [contact]
         if not self.interfaces:
-            raise ValueError("no contact interface given")
+            raise InputError("no contact interface given")
         self.bcs = list(bcs)
         self.a_form = dolfinx.fem.form(a)
         self.L_form = dolfinx.fem.form(L) if L is not None else None
@@ -225,7 +232,6 @@ class ContactProblem:
         self.ordering = ordering
         self.timings = {}
         self.increments: list[IncrementResult] = []
-        self.local_problem = None  # rank 0: the last increment's {dim, W, q, mu}
 
         t0 = time.perf_counter()
         self.K = assemble_stiffness(self.a_form, self.bcs)
@@ -238,7 +244,7 @@ class ContactProblem:
             else:
                 check_bodies(self.K, self.V, cell_tags, names, self.comm)
         elif floating:
-            raise ValueError("floating=True needs bodies=(cell_tags, {name: cell tag}) to find "
+            raise InputError("floating=True needs bodies=(cell_tags, {name: cell tag}) to find "
                              "the bodies held only by contact")
         t0 = time.perf_counter()
         self.pairs, self.mu, self.m = pair_interfaces(self.V, self.interfaces, self.comm)
@@ -249,97 +255,80 @@ class ContactProblem:
         # Node–surface and rigid-target pairs follow the bodies: re-made before each increment.
         self.repairing = bool(repair_pairs) and any(i.pairing_used != "node_to_node"
                                                     for i in self.interfaces)
-        self.pairings = 1
         if contact_operator == "factor":
-            self.condensation = factor_path.FactorCondensation(
+            condensation = factor_path.FactorCondensation(
                 self.K, self.bcs, self.pairs, self.mu, self.dim, self.comm, self.options,
                 ordering=self.ordering)
         else:
-            self.condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
-                                             self.comm, self.options, self.flexibility_method,
-                                             ordering=self.ordering)
-        c = self.condensation
-        self.factorizations = c.factorizations
+            condensation = Condensation(self.K, self.bcs, self.pairs, self.mu, self.dim,
+                                        self.comm, self.options, self.flexibility_method,
+                                        ordering=self.ordering)
+        self.stepper = Stepper(condensation, self.comm, expand_key="solution_c",
+                               timings=self.timings)
+        c = condensation
         self.timings.update(c.timings)
-        self.factor, self.flex_info, self.n_contact_dofs = c.factor, c.flex_info, c.n_contact_dofs
-        self.contact, self.B, self.W, self.x0, self.frames = c.contact, c.B, c.W, c.x0, c.frames
         if self.floating is not None:
             Rc = self.floating.contact_modes(c)
             self.floating.check_touched(Rc)
             if self.comm.rank == 0:
-                self.contact.set_rigid_modes(Rc)
+                c.contact.set_rigid_modes(Rc)
         self.outputs = ContactFields(self.V, self.comm, stress)
         o = self.outputs
         self.u, self.pressure, self.traction, self.status = o.u, o.pressure, o.traction, o.status
         self.von_mises = o.von_mises
 
+    # ---- what the stepper holds, read where it lives ----------------------------------
+    @property
+    def W(self) -> Optional[np.ndarray]:
+        """W = B F* Bᵀ of the current pairs (rank 0; None elsewhere and on the factor
+        path)."""
+        return self.stepper.operators()[1]
+
+    @property
+    def x0(self) -> Optional[np.ndarray]:
+        """The initial gaps of the current pairs (rank 0)."""
+        return self.stepper.operators()[2]
+
+    @property
+    def frames(self) -> Optional[np.ndarray]:
+        """(m, d, d) local frames of the current pairs (rank 0)."""
+        return self.stepper.operators()[3]
+
+    @property
+    def local_problem(self) -> Optional[dict]:
+        """Rank 0: the last increment's local problem {dim, W, q, mu}, u = W λ + q (slip
+        measured from the last gap), for inspection and cross-checks with other solvers."""
+        q = self.stepper.last_local_q
+        if q is None or self.comm.rank != 0:
+            return None
+        return {"dim": self.dim, "W": self.W, "q": q, "mu": self.mu}
+
     # ---- one increment ---------------------------------------------------------------
     def step(self) -> IncrementResult:
         """Solve one increment with the loads and Dirichlet values as they are set now."""
-        if self.contact_operator == "factor":
-            return factor_path.step(self)
         t0 = time.perf_counter()
         root = self.comm.rank == 0
         number = len(self.increments) + 1
+        where = f"increment {number}"
         if self.repairing:
-            self.repair()
+            self.stepper.repair(compat.petsc_vec(self.u), self.mu, where)
         p = assemble_load(self.V, self.a_form, self.L_form, self.bcs, self.comm)
-        e = None
+        after, on_failure = (), None
         if self.floating is not None:
             e = self.floating.loads(p)       # −Rᵀp, before K⁺ drops the fixing DOFs' loads
             self.floating.zero_fixed(p)
-        # With a factor that splits its solves, p is only condensed onto the contact DOFs
-        # here (forward elimination) and the kernel forms u_p,c = F* p̃_c; the expansion
-        # below finishes the increment's one back-substitution (protocol in schur_solve.h).
-        split = getattr(self.factor, "has_condense", False)
-        up = None
-        if split:
-            upc = self.factor.condense(p)
-        else:
-            up = self.K.createVecRight()
-            self.factor.solve(p, up)
-            upc = self.condensation.gather(up)
-        if root:
-            upc = self.condensation.contact_values(upc)
-        out, failure = None, None
-        if root:
-            try:
-                t1 = time.perf_counter()
-                # the increment's one crossing into the kernel
-                step = self.contact.step_condensed if split else self.contact.step
-                out = step(upc) if e is None else step(upc, e)
-                # the local contact solve alone, for bench/ (the rest is sparse work)
-                self.timings["last_contact_step_s"] = time.perf_counter() - t1
-                q = out["local_q"]
-            except ConvergenceError as err:
-                failure = (f"increment {number}: {err}", dict(getattr(err, "report", {})), None)
-                if e is not None:
-                    failure = self._no_equilibrium(number, e, failure)
-                q = np.asarray(self.contact.local_q(self.contact.last_q))
-            except ValueError as err:
-                # e.g. a non-finite u_p: raised on every rank, not left to hang the others
-                failure, q = (f"increment {number}: {err}", None, None), None
-            # The increment's local problem u = W λ + q' (slip measured from the last gap),
-            # kept for inspection and for cross-checks with other solvers.
-            if q is not None:
-                self.local_problem = {"dim": self.dim, "W": self.W, "q": q, "mu": self.mu}
-        wait_for_root(self.comm)  # the others asleep through the kernel step, not spinning
-        failure = self.comm.bcast(failure, root=0)
-        if failure:
-            for v in (p, up):
-                if v is not None:
-                    v.destroy()
-            if failure[1] is None:
-                raise ValueError(failure[0])
-            error = (NoEquilibriumError if failure[2] else ConvergenceError)(failure[0])
-            error.report = failure[1]  # what the solvers did, on every rank
-            raise error
-        self._solution(p, up, out, split)
+            after = (e,) if root else ()
+            on_failure = lambda failure: self._no_equilibrium(number, e, failure)  # noqa: E731
+        try:
+            out = self.stepper.advance(p, compat.petsc_vec(self.u), where=where, after=after,
+                                       on_failure=on_failure)
+        finally:
+            p.destroy()
         if self.floating is not None:
             alpha = self.comm.bcast(out["alpha"] if root else None, root=0)
             self.floating.add_modes(compat.petsc_vec(self.u), alpha)
         self.u.x.scatter_forward()
-        inc = record_increment(out, number, self.u, self.comm, self.dim,
+        inc = record_increment(out if root else None, number, self.u, self.comm, self.dim,
                                time.perf_counter() - t0)
         self.increments.append(inc)
         if self.floating is not None:
@@ -348,26 +337,6 @@ class ContactProblem:
         self.outputs.write_back(inc, self.pairs)
         self._guard_zone(inc)
         return inc
-
-    def _solution(self, p: PETSc.Vec, up: Optional[PETSc.Vec], out: Optional[dict],
-                  split: bool) -> None:
-        """u = K⁻¹ (p + Bᵀ λ) (K⁺ for bodies held only by contact) into self.u: the expansion
-        of the condensed p from the contact values u_p,c + F* r_c (the kernel's
-        ``solution_c``; Bᵀ λ lives on the contact DOFs, so p's forward elimination serves),
-        or a second solve with a factor that cannot split. Destroys p and up."""
-        root = self.comm.rank == 0
-        if split:
-            n = self.condensation.dofs.size
-            uc = np.asarray(out["solution_c"])[:n] if root else np.zeros(0)
-            self.factor.expand(uc, compat.petsc_vec(self.u))
-        else:
-            r = self.condensation.reaction(out["reaction"] if root else None)
-            r.axpy(1.0, p)
-            self.factor.solve(r, compat.petsc_vec(self.u))
-            r.destroy()
-        for v in (p, up):
-            if v is not None:
-                v.destroy()
 
     def _no_equilibrium(self, number: int, e: np.ndarray, failure: tuple) -> tuple:
         """The failure of a bordered increment, with the body and mode that no contact force
@@ -397,19 +366,8 @@ class ContactProblem:
         """Re-make node–surface and rigid-target pairs at the current positions (the last
         increment's displacement, the rigid targets' displacement as set now): B, x0 and W
         are rebuilt from the stored F*, with no new factorization. Collective."""
-        uc = self.condensation.gather(compat.petsc_vec(self.u))
-        error = None
-        if self.comm.rank == 0:
-            try:
-                self.pairs.repair(self.condensation.contact_values(uc))
-                self.condensation.set_pairs(self.pairs, self.mu)
-            except ValueError as e:
-                error = f"increment {len(self.increments) + 1}: re-pairing: {e}"
-            c = self.condensation
-            self.contact, self.B, self.W, self.x0, self.frames = (c.contact, c.B, c.W, c.x0,
-                                                                  c.frames)
-        raise_on_every_rank(self.comm, error)
-        self.pairings += 1
+        self.stepper.repair(compat.petsc_vec(self.u), self.mu,
+                            f"increment {len(self.increments) + 1}")
 
     def _guard_zone(self, inc: IncrementResult) -> None:
         """Name the interfaces whose contact reached an open edge of a candidate surface
@@ -442,7 +400,8 @@ class ContactProblem:
 
     # ---- driver -------------------------------------------------------------------
     def solve(self, increments: int, load: Optional[Callable[[int, float], None]] = None,
-              writer=None, verbose: bool = True) -> list[IncrementSummary]:
+              writer: Optional[ResultWriter] = None,
+              verbose: bool = True) -> list[IncrementSummary]:
         """Run ``increments`` load increments.
 
         ``load(i, t)`` is called before increment i (1-based), t = i/increments, to set the
@@ -452,7 +411,7 @@ class ContactProblem:
         carries ``report``, a dict of what the solvers did (attempts, residual, iterations).
         """
         if not isinstance(increments, (int, np.integer)) or increments < 1:
-            raise ValueError(f"increments={increments!r}; it must be a positive integer")
+            raise InputError(f"increments={increments!r}; it must be a positive integer")
         out = []
         for i in range(1, increments + 1):
             if load is not None:

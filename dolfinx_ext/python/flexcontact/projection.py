@@ -9,6 +9,7 @@ facet's border.
 from __future__ import annotations
 
 import numpy as np
+from .errors import InputError
 
 _CHUNK = 2_000_000  # point × facet combinations per vectorised batch
 
@@ -81,7 +82,7 @@ def closest_points(P: np.ndarray, X: np.ndarray, facets: np.ndarray):
     n, (nf, nv) = P.shape[0], facets.shape
     d = X.shape[1]
     if nf == 0:
-        raise ValueError("closest_points: the surface has no facets")
+        raise InputError("closest_points: the surface has no facets")
     best = np.empty(n, np.int64)
     weights = np.empty((n, nv))
     chunk = max(1, _CHUNK // nf)

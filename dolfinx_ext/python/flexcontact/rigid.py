@@ -14,8 +14,11 @@ from dataclasses import dataclass, field
 from typing import Optional, Sequence
 
 import numpy as np
+from . import names
+from .errors import InputError
+from .names import check_option
 
-RIGID_KINDS = ("plane", "circle", "sphere")
+RIGID_KINDS = names.RIGID_KINDS
 
 
 @dataclass
@@ -44,29 +47,27 @@ class RigidTarget:
 
     def __post_init__(self):
         label = self.name or f"rigid {self.kind}"
-        if self.kind not in RIGID_KINDS:
-            raise ValueError(f"rigid target {label!r}: kind={self.kind!r}; it must be one of "
-                             f"{', '.join(RIGID_KINDS)}")
+        check_option(self.kind, RIGID_KINDS, "kind", f"rigid target {label!r}")
         p = np.asarray(self.point_m, dtype=float).reshape(-1)
         if p.size not in (2, 3) or not np.all(np.isfinite(p)):
-            raise ValueError(f"rigid target {label!r}: point_m={self.point_m!r}; it must be "
+            raise InputError(f"rigid target {label!r}: point_m={self.point_m!r}; it must be "
                              "2 or 3 finite coordinates")
         self.point_m = p
         if self.kind == "circle" and p.size != 2:
-            raise ValueError(f"rigid target {label!r}: a circle lives in 2D, got point_m "
+            raise InputError(f"rigid target {label!r}: a circle lives in 2D, got point_m "
                              f"with {p.size} coordinates (use kind='sphere' in 3D)")
         if self.kind == "sphere" and p.size != 3:
-            raise ValueError(f"rigid target {label!r}: a sphere lives in 3D, got point_m "
+            raise InputError(f"rigid target {label!r}: a sphere lives in 3D, got point_m "
                              f"with {p.size} coordinates (use kind='circle' in 2D)")
         if self.kind == "plane":
             n = np.asarray(self.normal if self.normal is not None else [], float).reshape(-1)
             length = float(np.linalg.norm(n)) if n.size == p.size else 0.0
             if not (np.isfinite(length) and length > 0):
-                raise ValueError(f"rigid target {label!r}: normal={self.normal!r}; a plane "
+                raise InputError(f"rigid target {label!r}: normal={self.normal!r}; a plane "
                                  f"needs a non-zero normal of {p.size} finite components")
             self.normal = n / length
         elif not (np.isfinite(self.radius_m) and self.radius_m > 0):
-            raise ValueError(f"rigid target {label!r}: radius_m={self.radius_m!r}; it must "
+            raise InputError(f"rigid target {label!r}: radius_m={self.radius_m!r}; it must "
                              "be a finite number > 0")
         if self.displacement_m is None:
             self.displacement_m = np.zeros(p.size)
@@ -80,7 +81,7 @@ class RigidTarget:
         """The prescribed translation [m], checked."""
         u = np.asarray(self.displacement_m, float).reshape(-1)
         if u.size != self.dim or not np.all(np.isfinite(u)):
-            raise ValueError(f"rigid target {self.name!r}: displacement_m="
+            raise InputError(f"rigid target {self.name!r}: displacement_m="
                              f"{self.displacement_m!r}; it must be {self.dim} finite numbers")
         return u
 
@@ -93,6 +94,6 @@ class RigidTarget:
         r = x - c
         length = np.linalg.norm(r, axis=1)
         if np.any(length <= 1e-12 * self.radius_m):
-            raise ValueError(f"rigid target {self.name!r}: a slave node lies at the centre, "
+            raise InputError(f"rigid target {self.name!r}: a slave node lies at the centre, "
                              "where the closest point of the surface is undefined")
         return r / length[:, None], np.full(x.shape[0], float(self.radius_m))

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from mpi4py import MPI
+from .errors import InputError
 
 _MODE_NAMES = {2: ["translation along x", "translation along y", "rotation about z"],
                3: ["translation along x", "translation along y", "translation along z",
@@ -97,7 +98,7 @@ def _free_body(K, V, cell_tags, name, value, comm, rel_tol):
     blocks = _body_blocks(V, cell_tags, value)
     count = comm.allreduce(blocks.size, op=MPI.SUM)
     if count == 0:
-        raise ValueError(f"body '{name}': no cells carry the tag value {value}")
+        raise InputError(f"body '{name}': no cells carry the tag value {value}")
     c_local = coords[blocks].sum(axis=0) if blocks.size else np.zeros(gdim)
     centre = comm.allreduce(c_local, op=MPI.SUM) / count
     X = coords[blocks] - centre
@@ -157,7 +158,7 @@ def free_bodies(K, V, cell_tags, bodies: dict, comm=MPI.COMM_WORLD,
         elif body is not None:
             free.append(body)
     if problems:
-        raise ValueError("the stiffness matrix is singular: " + "; ".join(problems))
+        raise InputError("the stiffness matrix is singular: " + "; ".join(problems))
     return free
 
 
@@ -182,4 +183,4 @@ def check_bodies(K, V, cell_tags, bodies: dict, comm=MPI.COMM_WORLD, rel_tol: fl
         if problem:
             problems.append(problem)
     if problems:
-        raise ValueError("the stiffness matrix is singular: " + "; ".join(problems))
+        raise InputError("the stiffness matrix is singular: " + "; ".join(problems))

@@ -10,6 +10,7 @@ import numpy as np
 import dolfinx.fem
 
 from . import compat
+from .errors import InputError, InputTypeError
 
 
 def surface_nodes(V, facet_tags, value: int) -> dict:
@@ -38,7 +39,7 @@ def surface_nodes(V, facet_tags, value: int) -> dict:
             the tags are not facet tags of V's mesh, or V is not a whole P1 space.
     """
     if not isinstance(V, dolfinx.fem.FunctionSpace):
-        raise TypeError(f"surface_nodes: expected a dolfinx FunctionSpace, got "
+        raise InputTypeError(f"surface_nodes: expected a dolfinx FunctionSpace, got "
                         f"{type(V).__name__}")
     msh = V.mesh
     comm = msh.comm
@@ -62,24 +63,24 @@ def surface_nodes(V, facet_tags, value: int) -> dict:
 def _check_arguments(V, facet_tags, value, tdim, gdim):
     msh = V.mesh
     if facet_tags.dim != tdim - 1:
-        raise ValueError(f"the tags are of entity dimension {facet_tags.dim}, facet tags "
+        raise InputError(f"the tags are of entity dimension {facet_tags.dim}, facet tags "
                          f"(dimension {tdim - 1}) are needed")
     if not compat.tags_on_mesh(facet_tags, msh):
-        raise ValueError("the facet tags belong to another mesh than the function space")
+        raise InputError("the facet tags belong to another mesh than the function space")
     if gdim != tdim:
-        raise ValueError("surface nodes need a mesh whose geometric dimension equals its "
+        raise InputError("surface nodes need a mesh whose geometric dimension equals its "
                          f"topological dimension (got gdim={gdim}, tdim={tdim})")
     if compat.is_subspace(V):
-        raise ValueError("surface nodes need a whole function space, not a sub-space")
+        raise InputError("surface nodes need a whole function space, not a sub-space")
     nv_cell = compat.geometry_dofmap(msh).shape[1]
     per_cell = compat.cell_dofs(V).shape[1]
     if per_cell != nv_cell or compat.cell_vertex_count(msh) != nv_cell:
-        raise ValueError(f"surface nodes need a P1 space on an affine mesh: {per_cell} nodes "
+        raise InputError(f"surface nodes need a P1 space on an affine mesh: {per_cell} nodes "
                          f"per cell, {compat.cell_vertex_count(msh)} vertices")
     local = np.unique(facet_tags.values)
     present = np.unique(np.concatenate(msh.comm.allgather(local)))
     if value not in present:
-        raise ValueError(f"facet tag value {value} does not occur on any facet of the mesh; "
+        raise InputError(f"facet tag value {value} does not occur on any facet of the mesh; "
                          f"the facet tags hold the values {present.tolist()}")
 
 

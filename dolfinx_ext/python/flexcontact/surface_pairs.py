@@ -7,7 +7,7 @@ then one reference node per rigid target, which has no DOFs. The candidate set i
 F* on it is computed once; re-pairing only changes each pair's master nodes, weights, frame
 and offset, and the kernel rebuilds B, x0 and W from the stored F*.
 
-Node–surface (DESIGN.md §2): each slave node is paired with its closest point on the master
+Node–surface (docs/architecture.md §4, "Pairing models"): each slave node is paired with its closest point on the master
 facets, with the facet's shape-function weights there. The frame's normal at that point is
 the *smoothed* normal Σ w_j n_j (normalised), n_j the measure-weighted mean of the outward
 normals of the master facets around node j: it is continuous as a slave node passes from
@@ -25,6 +25,7 @@ from .mortar import mortar_rows_2d, mortar_rows_3d
 from .mortar_3d import full_measures
 from .projection import (boundary_nodes, closest_points, facet_measures, facet_normals,
                          nodal_normals)
+from .errors import InputError
 
 
 @dataclass
@@ -320,7 +321,7 @@ def build_surface_pairs(parts: list, dim: int, labels=None) -> SurfacePairs:
     for i, p in enumerate(pairers):
         if isinstance(p, SurfaceToSurfacePairer) and p.covered == 0:
             label = labels[i] if labels else f"interface {i}"
-            raise ValueError(
+            raise InputError(
                 f"surface–surface contact ({label}): none of the {p.slave_rows.size} slave "
                 "nodes is covered by a master facet facing it (outward normals opposite, "
                 f"within {p.cutoff_m:.3g} m): the slave and master tags name surfaces that "

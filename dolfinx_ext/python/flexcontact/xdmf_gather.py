@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 
 from . import compat
+from .errors import SolveError
 
 # DOLFINx's cell-local vertex order → the XDMF/VTK order (tensor-product cells differ).
 TOPOLOGY_TYPES = {
@@ -76,7 +77,7 @@ class MeshGather:
         cell_ids = np.concatenate([p[2] for p in parts])
         self.cell_order = np.sort(cell_ids)
         if len(np.unique(cell_ids)) != len(cell_ids):
-            raise RuntimeError("ResultWriter: a cell is owned by two ranks")
+            raise SolveError("ResultWriter: a cell is owned by two ranks")
         cells = np.concatenate([p[3] for p in parts])[np.argsort(cell_ids)]
         self.cells = np.searchsorted(self.nodes, cells)
         if perm is not None:
@@ -135,7 +136,7 @@ class MeshGather:
         pos = self._cell_positions(ids) if center == "Cell" else np.searchsorted(self.nodes, ids)
         n = len(self.cell_order) if center == "Cell" else len(self.nodes)
         if len(pos) != n or len(np.unique(pos)) != n:
-            raise RuntimeError(f"ResultWriter: field '{name}' has {len(np.unique(pos))} "
+            raise SolveError(f"ResultWriter: field '{name}' has {len(np.unique(pos))} "
                                f"owned values for {n} entities")
         full = np.empty((n, values.shape[1]))
         full[pos] = values

@@ -8,7 +8,7 @@
 * :mod:`~flexcontact.dam.section` linearises the base section (heel and toe stresses) and
   finds peak stresses at an offset from a point.
 """
-from .floating import floating_draft_m, segment_area_m2, westergaard_added_mass_kg_m2
+from .buoyancy import floating_draft_m, segment_area_m2, westergaard_added_mass_kg_m2
 from .scenario import CONCRETE, ROCK, WOOD, DamScenario
 
 __all__ = ["DamScenario", "CONCRETE", "ROCK", "WOOD", "floating_draft_m", "segment_area_m2",

@@ -1,16 +1,19 @@
 """One impact scenario from a factored DamModel and LogModel: the bodies are coupled only
-through contact (DESIGN.md §1, per-body condensation).
+through contact (docs/architecture.md §7, per-body condensation).
 
 The contact nodes are the placed log's front-end nodes (slaves, first) and the nodes of the
 dam's face strip (masters, node–surface, paired once as stage 2 does). The kernel's F is
-block-diagonal, [W_log (rotated), W_face], so ``_cpp.ImpactContact`` is used unchanged.
-Each Moreau–Jean step (θ-scheme, dynamics.py):
+block-diagonal, [F̂_log (rotated), F̂_face], so ``_cpp.ImpactContact`` is used unchanged, and
+each Moreau–Jean step (θ-scheme, dynamics.py) goes through the stepper for separately
+condensed bodies (stepper.BodiesStepper):
 
-1. free velocity of each body: a back-substitution with its own factor, skipped while the
-   body has received no impulse (then it is exactly its rest/rigid-flight velocity);
+1. each body's right-hand side h[−K (w + hθ ω)], condensed onto its contact DOFs with its
+   own factor, skipped while the body has received no impulse (it is then exactly at
+   rest, or in rigid flight for the log);
 2. the kernel's contact step on the contact DOFs (one crossing of the binding);
-3. if an impulse was applied: the velocity correction of each body, Ŵ_b⁻¹ S_bᵀ r_b;
-4. w ← w + h (θ v⁺ + (1 − θ) v⁻) per body.
+3. each body's velocity change Δω = Ŵ_b⁻¹ (r_b + S_bᵀ P_b) by its expansion: with the
+   condensation, one back-substitution per body and step;
+4. w ← w + h (θ ω⁺ + (1 − θ) ω⁻) per body.
 """
 from __future__ import annotations
 
@@ -23,6 +26,7 @@ from .. import _cpp
 from ..condensation import kernel_pairs
 from ..impact_output import contact_metrics
 from ..postprocess import _nodal_contact
+from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .log_model import rotation
 from .stage2 import MARGIN, approach_time_s, response_duration_s
@@ -45,19 +49,32 @@ class _Body:
         self.model, self.w, self.omega = model, model.new_vector(), model.new_vector()
         self.pushed = False
 
-    def free(self):
-        """ω_free (a new Vec), or None while at rest (then ω_free = ω = 0 exactly)."""
-        return self.model.free_velocity(self.w, self.omega) if self.pushed else None
+    def rhs(self):
+        """h[−K (w + hθ ω)] (a new Vec), or None while at rest (then it is exactly zero)."""
+        return self.model.step_rhs(self.w, self.omega) if self.pushed else None
 
-    def advance(self, vfree, dv, h: float, theta: float) -> None:
-        v_new = vfree if vfree is not None else self.omega.copy()
+    def advance(self, dv, h: float, theta: float) -> None:
+        v_new = self.omega.copy()
         if dv is not None:
             v_new.axpy(1.0, dv)
+            dv.destroy()
             self.pushed = True
         self.w.axpy(h * theta, v_new)
         self.w.axpy(h * (1.0 - theta), self.omega)
         self.omega.destroy()
         self.omega = v_new
+
+
+def _dam_solve_counter(dam):
+    def count():
+        dam.back_substitutions["dam_stage2"] += 1
+    return count
+
+
+def _log_solve_counter(log):
+    def count():
+        log.back_substitutions += 1
+    return count
 
 
 def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
@@ -87,23 +104,25 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
     n = int(round(duration / h))
     records, heel, peak_principal, p_peak = [], -math.inf, -math.inf, 0.0
     solves0 = (dam.back_substitutions["dam_stage2"], log.back_substitutions)
+    stepper = BodiesStepper(kernel, [
+        CondensedBody("log", log.factor, log.front_dofs, log.new_vector, rotation=R,
+                      counted=_log_solve_counter(log)),
+        CondensedBody("dam", dam.factor, dam.face_dofs, dam.new_vector,
+                      counted=_dam_solve_counter(dam))], expand_key="velocity_change_c")
     for i in range(n):
         t = i * h
-        vf_d, vf_l = bd.free(), bl.free()
         u_c = np.concatenate([_log_values(log, bl.w, R, V0 * t),
                               u_face0 + bd.w.array_r[dam.face_dofs]])
         v_c = np.concatenate([_log_values(log, bl.omega, R, V0),
                               bd.omega.array_r[dam.face_dofs]])
-        vf_c = np.concatenate([_log_values(log, vf_l if vf_l is not None else bl.omega, R, V0),
-                               (vf_d if vf_d is not None else bd.omega).array_r[dam.face_dofs]])
-        out = kernel.step(u_c, v_c, vf_c)
-        r = np.asarray(out["reaction"])
-        dv_d = dv_l = None
-        if np.any(r != 0.0):
-            dv_l = log.correction((r[:n_log].reshape(-1, d) @ R).reshape(-1))  # Rᵀ per node
-            dv_d = dam.correction(r[n_log:])
-        bd.advance(vf_d, dv_d, h, theta)
-        bl.advance(vf_l, dv_l, h, theta)
+        rhs = [bl.rhs(), bd.rhs()]
+        out, (dv_l, dv_d) = stepper.advance(rhs, where=f"time step {i + 1}", before=(u_c, v_c),
+                                            free_shift=v_c)
+        for b in rhs:
+            if b is not None:
+                b.destroy()
+        bd.advance(dv_d, h, theta)
+        bl.advance(dv_l, h, theta)
         active = int(np.asarray(out["active"], bool).sum())
         records.append(SimpleNamespace(t_s=(i + 1) * h, active=active,
                                        normal_force=float(out["normal_impulse"]) / h))

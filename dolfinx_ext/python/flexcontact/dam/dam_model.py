@@ -1,6 +1,6 @@
 """The dam and its foundation alone, factored once for a whole sweep of impacts.
 
-DESIGN.md §1 (per-body condensation): the dam is linear and touches the log only through
+docs/architecture.md §7 (per-body condensation): the dam is linear and touches the log only through
 contact, so everything it contributes to an impact scenario comes from two factorizations
 made once per dam mesh:
 
@@ -49,6 +49,7 @@ from ..pairing import _candidate_surface
 from .section import BaseSection, offset_sample_cells
 from .stage1 import DamMesh, _measures, _sections, body_loads
 from .stage2 import stage2_supports
+from ..errors import InputError, SolveError
 
 STRIP = 1
 """Tag of the face-strip facets in the DamModel's own strip MeshTags."""
@@ -91,7 +92,7 @@ class DamModel:
     def __init__(self, base, dt_s: float, water_levels_m=None, comm=MPI.COMM_SELF,
                  strip_m=None, theta: float = 0.5):
         if comm.size != 1:
-            raise ValueError(f"comm of size {comm.size}: DamModel is serial (one rank; "
+            raise InputError(f"comm of size {comm.size}: DamModel is serial (one rank; "
                              "parallel sweeps run one DamModel per process)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
         lo, hi = _levels(base, water_levels_m)
@@ -147,7 +148,7 @@ class DamModel:
         x = compat.petsc_vec(uh)
         self._ksp1.solve(p, x)
         if self._ksp1.getConvergedReason() < 0:
-            raise RuntimeError(f"stage 1 at water_level_m={key}: the MUMPS solve failed")
+            raise SolveError(f"stage 1 at water_level_m={key}: the MUMPS solve failed")
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         p.destroy()
         self.back_substitutions["dam_stage1"] += 1
@@ -192,25 +193,10 @@ class DamModel:
         x.zeroEntries()
         return x
 
-    def free_velocity(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
-        """v_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)] (one back-substitution)."""
-        out = setup.unloaded_free_velocity(self.K, self.factor, self.dt, self.theta, w, omega)
-        self.back_substitutions["dam_stage2"] += 1
-        return out
+    def step_rhs(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
+        """h[−K (w + hθ ω)]: the right-hand side of a time step with no load (a new Vec)."""
+        return setup.unloaded_step_rhs(self.K, self.dt, self.theta, w, omega)
 
-    def correction(self, r_face: np.ndarray) -> PETSc.Vec:
-        """Ŵ⁻¹ Sᵀ r: the velocity change from the contact impulses ``r_face`` (N·s) on the
-        strip's DOFs (one back-substitution)."""
-        r = self.new_vector()
-        r.setValues(self.face_dofs.astype(PETSc.IntType), r_face, addv=PETSc.InsertMode.ADD_VALUES)
-        r.assemble()
-        dv = self.new_vector()
-        self.factor.solve(r, dv)
-        self.back_substitutions["dam_stage2"] += 1
-        r.destroy()
-        return dv
-
-    # ---- outputs -------------------------------------------------------------------------
     def _heel_functional(self):
         """g with σ_heel(w) − σ_heel(0) = g·w: the heel stress of the dam's internal nodal
         forces −K_dam w at the base nodes (linear in w)."""
@@ -277,9 +263,9 @@ def _levels(base, water_levels_m) -> tuple[float, float]:
     try:
         lo, hi = (float(z) for z in water_levels_m)
     except (TypeError, ValueError):
-        raise ValueError(f"water_levels_m={water_levels_m!r}: give (lowest, highest) in m")
+        raise InputError(f"water_levels_m={water_levels_m!r}: give (lowest, highest) in m")
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi <= base.dam_height_m):
-        raise ValueError(f"water_levels_m={water_levels_m!r}: need 0 < lowest <= highest <= "
+        raise InputError(f"water_levels_m={water_levels_m!r}: need 0 < lowest <= highest <= "
                          f"dam_height_m={base.dam_height_m}")
     for z in (lo, hi):
         base.replace(water_level_m=z)  # the log must float at both ends (checked there)

@@ -29,6 +29,7 @@ formulas are quoted as they are commonly reproduced — check the edition you de
 from __future__ import annotations
 
 import math
+from ..errors import InputError
 
 G_M_S2 = 9.80665
 """Standard gravity used by the formulas (m/s²)."""
@@ -40,7 +41,7 @@ HAEHNEL_DALY_STIFFNESS_N_M = 2.4e6
 def _positive(**values) -> None:
     for name, v in values.items():
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise ValueError(f"{name}={v!r}: must be a finite number > 0")
+            raise InputError(f"{name}={v!r}: must be a finite number > 0")
 
 
 def asce7_force_N(weight_N: float, v_m_s: float, dt_s: float = 0.03, C_I: float = 1.0,

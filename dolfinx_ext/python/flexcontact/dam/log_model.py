@@ -30,6 +30,7 @@ from ..forms import Material, elasticity_form, mass_form
 from ..meshes import dam as dam_mesh
 from ..meshes import dam_tags as T
 from ..pairing import _candidate_surface
+from ..errors import InputError
 
 
 def rotation(pitch_deg: float) -> np.ndarray:
@@ -55,7 +56,7 @@ class LogMesh:
     def __init__(self, length_m: float, diameter_m: float, E: float, nu: float,
                  h_m: float = None, comm=MPI.COMM_SELF):
         if comm.size != 1:
-            raise ValueError(f"comm of size {comm.size}: LogModel is serial (one rank)")
+            raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         self.length_m, self.diameter_m = float(length_m), float(diameter_m)
         h = h_m if h_m is not None else diameter_m / 4
         self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(comm, length_m,
@@ -89,7 +90,7 @@ class LogModel:
                  E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
                  comm=MPI.COMM_SELF, mesh: "LogMesh" = None):
         if comm.size != 1:
-            raise ValueError(f"comm of size {comm.size}: LogModel is serial (one rank)")
+            raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
         self.material = Material(E_Pa=E, nu=nu, rho_kg_m3=rho_effective_kg_m3,
                                  name="wood+added mass")
@@ -148,21 +149,10 @@ class LogModel:
     def W_front_global(self, R: np.ndarray) -> np.ndarray:
         return rotate_blocks(self.W_front, R)
 
-    def free_velocity(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
-        """ω_free = ω + Ŵ⁻¹ h[−K (w + hθ ω)] (one back-substitution), local frame."""
-        out = setup.unloaded_free_velocity(self.K, self.factor, self.dt, self.theta, w, omega)
-        self.back_substitutions += 1
-        return out
-
-    def correction(self, r_front_local: np.ndarray) -> PETSc.Vec:
-        """Ŵ⁻¹ Sᵀ r for impulses (N·s, local frame) on the front end's DOFs."""
-        r = self.new_vector()
-        r.array[self.front_dofs] = r_front_local
-        dv = self.new_vector()
-        self.factor.solve(r, dv)
-        self.back_substitutions += 1
-        r.destroy()
-        return dv
+    def step_rhs(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
+        """h[−K (w + hθ ω)]: the right-hand side of a time step with no load, local frame
+        (a new Vec)."""
+        return setup.unloaded_step_rhs(self.K, self.dt, self.theta, w, omega)
 
     def momentum_local(self, omega: PETSc.Vec) -> np.ndarray:
         """Σ (M ω) per local component (N·s/m): the momentum of the velocity ω."""

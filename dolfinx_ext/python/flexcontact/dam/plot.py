@@ -5,6 +5,7 @@ import numpy as np
 
 from .. import compat
 from ..meshes import dam_tags as T
+from ..errors import InputError
 
 _BODY_COLOURS = {T.DAM: "#c9c3b8", T.FOUNDATION: "#a88f6a", T.LOG: "#7a4f1e"}
 _FACET_COLOURS = {T.FOUNDATION_BOTTOM: "black", T.FOUNDATION_SIDES: "dimgray",
@@ -36,7 +37,7 @@ def plot_groups(mesh, path, scenario=None) -> None:
     level dashed. Collective (data gathered to rank 0)."""
     msh = mesh.msh
     if msh.geometry.dim != 2:
-        raise ValueError("plot_groups draws 2D meshes only")
+        raise InputError("plot_groups draws 2D meshes only")
     cells, facets = _gather_cells(msh, mesh.cell_tags), _gather_facets(msh, mesh.facet_tags)
     if msh.comm.rank != 0:
         return

@@ -1,7 +1,7 @@
-"""Many impact scenarios on one dam for the price of its factorizations (issue: the sweep).
+"""Many impact scenarios on one dam for the price of its factorizations.
 
 Stage 2 (stage2.py) meshes the dam, its foundation and the log together and factors the
-whole iteration matrix for every scenario. Here the bodies are apart (DESIGN.md §1,
+whole iteration matrix for every scenario. Here the bodies are apart (docs/architecture.md §7,
 per-body condensation; they touch only through contact):
 
 * :class:`~flexcontact.dam.dam_model.DamModel`: the dam + foundation without the log, with
@@ -19,6 +19,7 @@ serves the whole sweep (:func:`sweep_time_step_s`). 2D only.
 from __future__ import annotations
 
 import time
+from typing import Optional
 
 from mpi4py import MPI
 
@@ -26,7 +27,9 @@ from .. import impact_setup as setup
 from .coupled_step import expected_contact_s, run_impact
 from .dam_model import DamModel
 from .log_model import LogMesh, LogModel
+from .scenario import DamScenario
 from .stage2 import sweep_time_step_s
+from ..errors import InputError
 
 DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
                   "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
@@ -36,18 +39,18 @@ DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "d
 """Parameters fixed by the dam's factorizations: a scenario must share them with the base."""
 
 
-def check_same_dam(base, scenario) -> None:
+def check_same_dam(base: DamScenario, scenario: DamScenario) -> None:
     """ValueError naming the first dam parameter in which ``scenario`` differs from
     ``base`` (those need another DamModel)."""
     for name in DAM_PARAMETERS:
         a, b = getattr(base, name), getattr(scenario, name)
         if a != b:
-            raise ValueError(f"{name}={b!r} differs from the dam being reused ({name}={a!r}); "
+            raise InputError(f"{name}={b!r} differs from the dam being reused ({name}={a!r}); "
                              "a scenario may change only the log, its speed and angles, the "
                              "friction and the water level")
 
 
-def log_key(s) -> tuple:
+def log_key(s: DamScenario) -> tuple:
     """What a LogModel depends on: length, diameter, density, added-mass coefficient, E, ν."""
     return (s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3, s.added_mass_coefficient,
             s.wood.E_Pa, s.wood.nu)
@@ -63,16 +66,18 @@ class ScenarioEvaluator:
     the distance from the first-contact point at which the peak principal stress is read.
     """
 
-    def __init__(self, base, dt_s: float | None = None, water_levels_m=None,
-                 comm=MPI.COMM_SELF, *, strip_m=None, offset_m: float = 1.0):
+    def __init__(self, base: DamScenario, dt_s: Optional[float] = None,
+                 water_levels_m: Optional[tuple[float, float]] = None,
+                 comm: MPI.Comm = MPI.COMM_SELF, *,
+                 strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0):
         if base.dim != 2:
-            raise ValueError(f"dim={base.dim}: the scenario evaluator is 2D only")
+            raise InputError(f"dim={base.dim}: the scenario evaluator is 2D only")
         if base.westergaard:
-            raise ValueError("westergaard=True: the reservoir's added mass depends on the water "
+            raise InputError("westergaard=True: the reservoir's added mass depends on the water "
                              "level, so one factored dam cannot serve a sweep over it; use the "
                              "monolithic evaluator (engine.evaluator = \"monolithic\")")
         if not offset_m > 0:
-            raise ValueError(f"offset_m={offset_m!r}: must be > 0 m")
+            raise InputError(f"offset_m={offset_m!r}: must be > 0 m")
         self.base, self.offset_m = base, float(offset_m)
         self.dt = float(dt_s) if dt_s is not None else sweep_time_step_s([base])
         t0 = time.perf_counter()
@@ -83,12 +88,12 @@ class ScenarioEvaluator:
         self._log_meshes: dict = {}  # a log geometry's mesh, K and unit mass, every density
         self.setup_s = time.perf_counter() - t0
 
-    def check(self, scenario) -> None:
+    def check(self, scenario: DamScenario) -> None:
         """ValueError naming the parameter if ``scenario`` cannot reuse this dam."""
         check_same_dam(self.base, scenario)
         lo, hi = self.dam.water_levels_m
         if not lo <= scenario.water_level_m <= hi:
-            raise ValueError(f"water_level_m={scenario.water_level_m!r}: outside the range "
+            raise InputError(f"water_level_m={scenario.water_level_m!r}: outside the range "
                              f"{(lo, hi)} the dam was built for (water_levels_m)")
         setup.check_resolution(self.dt, expected_contact_s(scenario, self.dam),
                                "2L/c of the log along the face normal")
@@ -96,13 +101,13 @@ class ScenarioEvaluator:
         front = scenario.log_centre[-1] + 0.5 * scenario.log_length_m * scenario.log_axis[-1]
         reach = scenario.log_radius_m * abs(scenario.log_axis[0])
         if not (z0 <= front - reach and front + reach <= z1):
-            raise ValueError(
+            raise InputError(
                 f"log_pitch_deg={scenario.log_pitch_deg!r}, water_level_m="
                 f"{scenario.water_level_m!r}: the log's front end (elevations "
                 f"{front - reach:.3f}..{front + reach:.3f} m) leaves the face strip "
                 f"{z0:.3f}..{z1:.3f} m of this dam (strip_m)")
 
-    def log_model(self, s) -> LogModel:
+    def log_model(self, s: DamScenario) -> LogModel:
         """The cached LogModel of the scenario's log (made on first use)."""
         key = log_key(s)
         if key not in self._logs:
@@ -118,7 +123,7 @@ class ScenarioEvaluator:
                 mesh=self._log_meshes[geometry])
         return self._logs[key]
 
-    def evaluate(self, scenario) -> dict:
+    def evaluate(self, scenario: DamScenario) -> dict[str, float]:
         """The outputs of one scenario (plain floats): peak_force_N_per_m,
         contact_duration_s, impulse_N_s_per_m, log_momentum_change_N_s_per_m (along x,
         negative: the log is slowed), heel_stress_static_Pa, heel_stress_impact_Pa (most

@@ -9,7 +9,7 @@ vertical downstream face under the crest down to the *knee*, then the downstream
 (the slope line runs through the upstream crest corner).
 
 The log floats: its axis elevation follows from the water level and its draft (see
-:mod:`flexcontact.dam.floating`); it is pitched (front end up for a positive angle) and, in
+:mod:`flexcontact.dam.buoyancy`); it is pitched (front end up for a positive angle) and, in
 3D, yawed about the vertical axis, and is placed so that its point nearest the dam is
 ``log_gap_m`` upstream of the face, at mid-width of the block in 3D. A pitched log keeps the
 centre elevation of the horizontal floating log (exact for s = 1/2 by the symmetry of the
@@ -38,7 +38,7 @@ import numpy as np
 
 from ..forms import Material
 from ..forms.loads import STANDARD_GRAVITY_M_S2, WATER_DENSITY_KG_M3
-from .floating import floating_draft_m
+from .buoyancy import floating_draft_m
 
 CONCRETE = Material(E_Pa=25e9, nu=0.2, rho_kg_m3=2400.0, name="concrete")
 """Mass concrete of a gravity dam."""

@@ -25,6 +25,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from .. import compat
+from ..errors import InputError
 
 
 def tipping_moment(arm: np.ndarray, force: np.ndarray) -> np.ndarray:
@@ -167,7 +168,7 @@ def offset_samples(msh, point, offset_m: float, cell_tags=None, tag=None, sample
     points (n, 3), the indices of those in this rank's cells (tagged ``tag`` if given) and
     their cells."""
     if not offset_m > 0:
-        raise ValueError(f"offset_m={offset_m!r}: must be > 0")
+        raise InputError(f"offset_m={offset_m!r}: must be > 0")
     gdim = msh.geometry.dim
     pts = np.zeros((samples if gdim == 2 else 4 * samples, 3))
     dirs = sample_directions(gdim, pts.shape[0])

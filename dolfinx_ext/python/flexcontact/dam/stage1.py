@@ -37,6 +37,7 @@ from ..meshes import dam as dam_mesh
 from ..meshes import dam_tags as T
 from .section import BaseSection, nodal_section
 from .statics import hand_statics, uplift_resultant
+from ..errors import SolveError
 
 
 class DamMesh(NamedTuple):
@@ -132,7 +133,7 @@ def linear_solve(K, p, u) -> None:
     reason = ksp.getConvergedReason()
     ksp.destroy()
     if reason < 0:
-        raise RuntimeError(f"stage 1: the MUMPS solve failed (KSP reason {reason})")
+        raise SolveError(f"stage 1: the MUMPS solve failed (KSP reason {reason})")
     x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
 

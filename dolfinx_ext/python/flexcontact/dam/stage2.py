@@ -48,6 +48,7 @@ from .fields import StressFields
 from .kinematics import LogKinematics
 from .section import peak_at_offset
 from .stage1 import _measures, body_loads, dam_section, section_form
+from ..errors import InputError
 
 MARGIN = 1.5
 """The run lasts approach + MARGIN × the expected contact duration (2L/c of the log)."""
@@ -127,7 +128,7 @@ def sweep_time_step_s(scenarios) -> float:
     The speed does not enter: an elastic impact lasts 2L/c whatever the speed."""
     steps = [default_time_step_s(s) for s in scenarios]
     if not steps:
-        raise ValueError("scenarios: empty; give at least one scenario to choose dt_s from")
+        raise InputError("scenarios: empty; give at least one scenario to choose dt_s from")
     return min(steps)
 
 
@@ -189,7 +190,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     """
     s = scenario
     if duration_s is not None and not (math.isfinite(duration_s) and duration_s > 0):
-        raise ValueError(f"duration_s={duration_s!r}: must be a finite number > 0 s")
+        raise InputError(f"duration_s={duration_s!r}: must be a finite number > 0 s")
     t0 = time.perf_counter()
     dt = dt_s if dt_s is not None else default_time_step_s(s)
     problem = make_problem(s, stage1, dt)

@@ -11,6 +11,7 @@ import numbers
 import numpy as np
 
 from ..forms import Material
+from ..errors import InputError
 
 _POSITIVE = ("dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
              "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
@@ -26,7 +27,7 @@ def _real(x) -> bool:
 
 
 def _fail(name, value, why):
-    raise ValueError(f"{name}={value!r}: {why}")
+    raise InputError(f"{name}={value!r}: {why}")
 
 
 def check_scenario(s) -> None:

@@ -9,7 +9,7 @@ found, a table that survives being killed.
 * :mod:`.evaluators` picks the evaluator (:mod:`.monolithic` until the reusing one is there);
   :mod:`.engines` runs it serially, on processes, under MPI or on Dask;
 * :mod:`.table` appends one fsynced JSON row per finished scenario and resumes;
-* :mod:`.stats`, :mod:`.plots`, :mod:`.report` write what the engineer reads.
+* :mod:`.stats`, :mod:`.plots`, :mod:`.sweep_report` write what the engineer reads.
 """
 from .config import SweepConfig, from_dict, load
 from .driver import prepare, run

@@ -4,9 +4,10 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import Optional, TextIO, Union
 
-from . import engines, evaluators, report
-from .config import check_engine
+from . import engines, evaluators, sweep_report
+from .config import SweepConfig, check_engine
 from .errors import ConfigError
 from .evaluators import EvaluatorSpec
 from .progress import Progress
@@ -15,7 +16,7 @@ from .stats import KEY_OUTPUTS
 from .table import ResultTable
 
 
-def prepare(cfg) -> dict:
+def prepare(cfg: SweepConfig) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
     import), the sweep's time step and water levels."""
     base, points, scenarios = build_scenarios(cfg)
@@ -48,7 +49,8 @@ def check_all(spec: EvaluatorSpec, points: list, scenarios: list):
     return ev
 
 
-def run(cfg, out=None, check_convergence: bool = False, stream=None) -> dict:
+def run(cfg: SweepConfig, out: Optional[Union[str, Path]] = None,
+        check_convergence: bool = False, stream: Optional[TextIO] = None) -> dict:
     """Run (or resume) the sweep of ``cfg`` into ``out`` (default ``output.dir``); returns
     the summary also written to ``summary.json``."""
     check_engine(cfg.engine)
@@ -105,7 +107,7 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
                                               if rows else math.nan),
                 "base": prep["base"].as_dict(),
                 "evaluator_timings_s": _sum_timings(rows)}
-    summary = report.summarize(run_info, rows, inputs, outputs, cfg)
+    summary = sweep_report.summarize(run_info, rows, inputs, outputs, cfg)
     if prep["checker"] is not None and e["kind"] != "serial":
         # The evaluator that checked the scenarios in this process computed none of them.
         summary["counts_driver_check"] = prep["checker"].counts()
@@ -113,13 +115,13 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
     if check_convergence:
         summary["convergence"] = convergence(prep, summary["worst"])
     t_conv = time.perf_counter() - t_conv
-    summary["figures"] = (report.figures(folder, summary, rows, inputs, outputs)
+    summary["figures"] = (sweep_report.figures(folder, summary, rows, inputs, outputs)
                           if cfg.output["plots"] and rows else [])
     summary["timings_s"] = {**prep["timings_s"],
                             "report": time.perf_counter() - t0 - t_conv,
                             "convergence": t_conv}
     write_summary(folder, summary, comm=MPI.COMM_SELF)
-    (folder / "report.md").write_text(report.markdown(summary, inputs))
+    (folder / "report.md").write_text(sweep_report.markdown(summary, inputs))
     return summary
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 import os
 
 from .evaluators import evaluate_task, init_worker
+from ..errors import SolveError
 
 
 def default_workers() -> int:
@@ -75,7 +76,7 @@ def _dask(engine, spec, tasks, on_result):
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:
-        raise RuntimeError("engine.kind='dask' needs Dask distributed (Debian package "
+        raise SolveError("engine.kind='dask' needs Dask distributed (Debian package "
                            "python3-distributed; scripts/setup.sh installs it)") from None
     cluster = None
     if engine["scheduler"]:

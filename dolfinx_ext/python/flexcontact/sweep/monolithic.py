@@ -20,6 +20,7 @@ import time
 from mpi4py import MPI
 
 from ..dam.stage2 import sweep_time_step_s  # noqa: F401  (the sweep reads it from here)
+from ..errors import InputError
 
 IMPACT_OFFSET_M = 1.0
 """Distance from the first-contact point at which the dam's peak largest principal stress
@@ -46,7 +47,7 @@ class MonolithicEvaluator:
                  comm=MPI.COMM_SELF):
         if dt_s is not None and not (isinstance(dt_s, (int, float)) and math.isfinite(dt_s)
                                      and dt_s > 0):
-            raise ValueError(f"dt_s={dt_s!r}: must be None or a finite number > 0 s")
+            raise InputError(f"dt_s={dt_s!r}: must be None or a finite number > 0 s")
         self.base, self.dt_s, self.comm = base, dt_s, comm
         self._counts = {"factorizations": {"stage1": 0, "stage2": 0},
                         "back_substitutions": {"stage1": 0, "stage2": 0}}

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from .errors import SolveError
 
 
 def profile(problem, inc=None, axis: int = 0):
@@ -90,7 +91,7 @@ def approach_to_load(problem, set_approach, trial_m: float, target_force: float,
         if not final:
             P1 = force_scale * problem.increments[-1].summary.normal_force
             if P1 <= 0:
-                raise RuntimeError("the trial approach produced no contact force")
+                raise SolveError("the trial approach produced no contact force")
             final.append(trial_m * (target_force / P1) ** exponent)
         set_approach(trial_m + (final[0] - trial_m) * (i - 1) / (max(increments, 2) - 1))
 

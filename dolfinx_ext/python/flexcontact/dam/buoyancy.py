@@ -14,6 +14,7 @@ the water line (d = R).
 from __future__ import annotations
 
 import math
+from ..errors import InputError
 
 
 def segment_area_m2(radius_m: float, depth_m: float) -> float:
@@ -29,9 +30,9 @@ def floating_draft_m(radius_m: float, density_ratio: float) -> float:
     [0, 2R]). Raises ValueError unless 0 < s < 1 and R > 0.
     """
     if not (radius_m > 0 and math.isfinite(radius_m)):
-        raise ValueError(f"radius_m={radius_m!r}: must be a finite number > 0")
+        raise InputError(f"radius_m={radius_m!r}: must be a finite number > 0")
     if not 0.0 < density_ratio < 1.0:
-        raise ValueError(f"density_ratio={density_ratio!r}: a floating log needs "
+        raise InputError(f"density_ratio={density_ratio!r}: a floating log needs "
                          f"0 < rho_wood/rho_water < 1")
     target = density_ratio * math.pi * radius_m ** 2
     lo, hi = 0.0, 2.0 * radius_m
