@@ -131,7 +131,7 @@ void bind_errors(py::module& m)
 {
   static py::exception<ConvergenceError> convergence_error(m, "ConvergenceError",
                                                            m.attr("SolveError"));
-  py::register_exception_translator(
+  py::register_local_exception_translator(
       [](std::exception_ptr p)
       {
         try
@@ -159,13 +159,20 @@ py::handle flexcontact::bind_error_bases(py::module& m)
   py::module_ errors = py::module_::import("flexcontact.errors");
   m.attr("SolveError") = errors.attr("SolveError");
   m.attr("InputError") = errors.attr("InputError");
-  py::register_exception_translator(
+  // Local to this module: a global translator would also turn other pybind11 modules'
+  // errors (DOLFINx's, matplotlib's, and pybind11's own builtin exceptions, which are
+  // std::runtime_errors) into flexcontact's.
+  py::register_local_exception_translator(
       [](std::exception_ptr p)
       {
         try
         {
           if (p)
             std::rethrow_exception(p);
+        }
+        catch (const py::builtin_exception&)
+        {
+          throw; // pybind11's own (value_error, index_error, ...): its default translation
         }
         catch (const std::invalid_argument& e)
         {

@@ -324,9 +324,9 @@ void flexcontact::bind_petsc(py::module& m)
 {
   bind_schur_factor(m);
   py::handle base = m.attr("SolveError");
-  py::register_exception<SingularStiffnessError>(m, "SingularStiffnessError", base);
-  py::register_exception<MumpsError>(m, "MumpsError", base);
-  py::register_exception<PetscError>(m, "PetscError", base);
+  py::register_local_exception<SingularStiffnessError>(m, "SingularStiffnessError", base);
+  py::register_local_exception<MumpsError>(m, "MumpsError", base);
+  py::register_local_exception<PetscError>(m, "PetscError", base);
 
   bind_distributed_schur(m);
   bind_flexibility(m);

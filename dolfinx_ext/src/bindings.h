@@ -19,8 +19,8 @@ namespace flexcontact
 /// @brief The Python base of the module's runtime errors, flexcontact.errors.SolveError
 /// (a FlexcontactError and a RuntimeError), and the translation of the kernel's other
 /// exceptions: std::invalid_argument to InputError (a ValueError), std::runtime_error and
-/// std::logic_error to SolveError. Called first, so that the specific errors registered
-/// later are tried before it.
+/// std::logic_error to SolveError, for this module's functions only. Called first, so that
+/// the specific errors registered later (also local) are tried before it.
 pybind11::handle bind_error_bases(pybind11::module& m);
 
 /// @brief The flexibility F* from one MUMPS factorization, and the PETSc/MUMPS exceptions.
