@@ -7,7 +7,7 @@ parameter cannot leave the other ranks waiting in a broadcast.
 """
 
 import gmsh
-import dolfinx.io.gmshio as gmshio  # the submodule must be imported explicitly in 0.5
+from flexcontact import compat
 from flexcontact.mpi import raise_on_every_rank
 
 _owned = False  # True while gmsh was initialised by this module (so we finalise it)
@@ -52,9 +52,7 @@ def to_dolfinx(comm, gdim: int):
     finalises gmsh on rank 0 afterwards. Only elements in physical groups are kept.
     """
     try:
-        # DOLFINx 0.5–0.9 spelling; later versions return a MeshData tuple-like object.
-        out = gmshio.model_to_mesh(gmsh.model, comm, 0, gdim=gdim)
-        msh, cell_tags, facet_tags = out[0], out[1], out[2]
+        msh, cell_tags, facet_tags = compat.gmsh_model_to_mesh(gmsh.model, comm, 0, gdim)
     finally:
         if comm.rank == 0:
             stop()

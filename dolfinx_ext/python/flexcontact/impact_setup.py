@@ -163,11 +163,9 @@ def held_marker(template: PETSc.Mat, bcs: Sequence) -> PETSc.Vec:
 def assemble_matrices(a_form, m_form, bcs: Sequence, mass: str, marker: PETSc.Vec):
     """K and M with zero rows and columns at Dirichlet DOFs (their displacement and
     velocity stay zero). The lumped M is the row sum of the consistent one."""
-    K = dolfinx.fem.petsc.assemble_matrix(a_form, bcs=list(bcs), diagonal=0.0)
-    K.assemble()
+    K = compat.assemble_matrix(a_form, list(bcs), diagonal=0.0)
     if mass == "consistent":
-        M = dolfinx.fem.petsc.assemble_matrix(m_form, bcs=list(bcs), diagonal=0.0)
-        M.assemble()
+        M = compat.assemble_matrix(m_form, list(bcs), diagonal=0.0)
         return K, M
     full = dolfinx.fem.petsc.assemble_matrix(m_form)
     full.assemble()
