@@ -65,5 +65,7 @@ cmake --build "$build" -j "$(nproc)"
 site=$(/usr/bin/python3 -c "import site; print(site.getsitepackages()[0])")
 SUDO=""; [ "$(id -u)" -ne 0 ] && [ ! -w "$site" ] && SUDO="sudo"
 $SUDO mkdir -p "$site"
-echo "$here/dolfinx_ext/python" | $SUDO tee "$site/flexcontact.pth" >/dev/null
+# The second line maps the top-level forms/ and meshes/ in as flexcontact.forms and
+# flexcontact.meshes, as the wheel does (dolfinx_ext/python/flexcontact_checkout.py).
+printf '%s\nimport flexcontact_checkout\n' "$here/dolfinx_ext/python" | $SUDO tee "$site/flexcontact.pth" >/dev/null
 /usr/bin/python3 -c "import flexcontact, sys; print('flexcontact', flexcontact.__version__, 'ready:', flexcontact.__file__)"

@@ -10,6 +10,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "dolfinx_ext" / "python"))
+import flexcontact_checkout  # noqa: E402,F401  (forms/ and meshes/ as flexcontact's subpackages)
 
 
 def mpirun(n, script, *args, timeout=600, cwd=None, env=None):

@@ -59,8 +59,6 @@ def source_subpackages() -> set[str]:
     out = {"flexcontact", "flexcontact.forms", "flexcontact.meshes"}
     for init in PACKAGE.rglob("__init__.py"):
         rel = init.parent.relative_to(PACKAGE)
-        if rel.parts and rel.parts[0] in ("forms", "meshes"):
-            continue  # the links to the top-level folders
         out.add(".".join(("flexcontact",) + rel.parts))
     return out
 

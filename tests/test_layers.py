@@ -31,8 +31,6 @@ def _modules() -> dict[str, Path]:
         for path in sorted(folder.rglob("*.py")):
             rel = path.relative_to(folder).with_suffix("")
             parts = [p for p in rel.parts if p != "__init__"]
-            if prefix == "flexcontact" and parts and parts[0] in ("forms", "meshes"):
-                continue  # the links to the top-level folders: read there
             out[".".join([prefix, *parts])] = path
     return out
 

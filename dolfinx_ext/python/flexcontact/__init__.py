@@ -1,8 +1,9 @@
 """flexcontact: frictional contact and impact for FEniCSx by the condensed flexibility
 (mixed) method of Feng & Touzot."""
-# forms/ and meshes/ are top-level folders of the checkout; in it, the package reaches them
-# through the links flexcontact/forms and flexcontact/meshes, and the wheel maps them in
-# (pyproject.toml), so flexcontact.forms and flexcontact.meshes are ordinary subpackages.
+# forms/ and meshes/ are top-level folders of the repository and the subpackages
+# flexcontact.forms and flexcontact.meshes: the wheel maps them in (pyproject.toml), and a
+# checkout registered by scripts/setup.sh finds them as an editable install would
+# (dolfinx_ext/python/flexcontact_checkout.py).
 from .petsc_comm import init_for_futures as _init_for_futures
 
 _init_for_futures()  # before anything initialises PETSc: see petsc_comm.py
