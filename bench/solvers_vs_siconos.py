@@ -100,7 +100,7 @@ def bench_case(case):
         r["fc3d_error"] = cp.siconos_error(case, lam)
         r["lambda_diff_to_nsn_ac"] = float(np.linalg.norm(lam - ref)
                                            / max(np.linalg.norm(ref), lam_scale))
-        st = np.bincount(cp.states_of(case, lam), minlength=3)
+        st = cp.state_counts(cp.states_of(case, lam))
         r["states"] = dict(zip(cp.STATE_NAMES, st.tolist()))
     return rows
 

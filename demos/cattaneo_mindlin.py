@@ -23,6 +23,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
+from flexcontact.states import SLIP, STICK
 from flexcontact.contact_profile import hertz_fit, profile, zone_halfwidth
 from flexcontact.meshes import hertz2d, tags
 
@@ -107,14 +108,14 @@ if comm.rank == 0:
     Q = abs(summaries[-1].tangential_force[0])
     a_ref, p0_ref = analytic.hertz_cylinder(P, R, Estar)
     a_fit, p0, _ = hertz_fit(x, p)
-    c = zone_halfwidth(x, states == 1)
+    c = zone_halfwidth(x, states == STICK)
     c_ref = analytic.cattaneo_mindlin_stick_halfwidth(a_ref, Q, args.mu, P)
     q_ref = np.array([analytic.cattaneo_mindlin_shear(xi, a_ref, c_ref, args.mu, p0_ref) for xi in x])
     inside = np.abs(x) < a_ref
     shear_rms = float(np.sqrt(np.mean((np.abs(q[inside, 0]) - q_ref[inside]) ** 2)) / (args.mu * p0_ref))
     # Stick means no slip in the increment: the largest incremental slip of any stick pair
     # over the whole load path, relative to the largest displacement.
-    stick_slip = max(float(np.abs(inc.slip_increment[inc.states == 1]).max(initial=0.0))
+    stick_slip = max(float(np.abs(inc.slip_increment[inc.states == STICK]).max(initial=0.0))
                      for inc in problem.increments)
     umax = max(1e-300, float(np.abs(problem.u.x.array).max()))
     summary = {
@@ -129,7 +130,7 @@ if comm.rank == 0:
         "shear_rms_error_rel_mu_p0": shear_rms,
         "max_stick_slip_increment_rel": stick_slip / umax,
         "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
-        "stick_pairs": int((states == 1).sum()), "slip_pairs": int((states == 2).sum()),
+        "stick_pairs": int((states == STICK).sum()), "slip_pairs": int((states == SLIP).sum()),
         "h_contact_m": geo["h_contact"],
         "mesh": fc.output.mesh_info(V, refine=args.refine),
         **fc.output.run_record(problem, summaries, t_start),
@@ -147,7 +148,7 @@ if comm.rank == 0:
         ax.plot(xs * 1e3, [analytic.cattaneo_mindlin_shear(t, a_ref, c_ref, args.mu, p0_ref) / 1e6
                            for t in xs], "b-", label="Cattaneo–Mindlin q(x)")
         ax.plot(x * 1e3, p / 1e6, "ko", ms=3, label="pressure")
-        for st, mk, name in ((1, "bs", "shear, stick"), (2, "r^", "shear, slip")):
+        for st, mk, name in ((STICK, "bs", "shear, stick"), (SLIP, "r^", "shear, slip")):
             sel = states == st
             ax.plot(x[sel] * 1e3, np.abs(q[sel, 0]) / 1e6, mk, ms=4, label=name)
         ax.axvspan(-c_ref * 1e3, c_ref * 1e3, color="b", alpha=0.07, label="stick zone (theory)")

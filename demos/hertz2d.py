@@ -24,6 +24,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
+from flexcontact.states import OPEN
 from flexcontact.contact_profile import approach_to_load, hertz_fit, profile
 from flexcontact.meshes import hertz2d, tags
 
@@ -117,7 +118,7 @@ if comm.rank == 0:
         "pressure_rms_error_rel_p0": rms,
         "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
         "contact_pairs": int(problem.m),
-        "closed_pairs": int((states > 0).sum()),
+        "closed_pairs": int((states > OPEN).sum()),
         "contact_dofs": int(problem.n_contact_dofs),
         "mesh": fc.output.mesh_info(V, h_contact_m=geo["h_contact"], refine=args.refine),
         **fc.output.run_record(problem, summaries, t_start),

@@ -30,6 +30,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
+from flexcontact.states import OPEN
 from flexcontact.contact_profile import approach_to_load, elliptic_fit, hertz_fit, profile
 from flexcontact.meshes import hertz2d, tags
 
@@ -135,7 +136,7 @@ if comm.rank == 0:
         "p_nodal_max": p_nodal_max, "p_nodal_max_error_rel": p_nodal_max / p0_ref - 1,
         "pressure_rms_error_rel_p0": rms,
         "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
-        "contact_pairs": int(problem.m), "closed_pairs": int((states > 0).sum()),
+        "contact_pairs": int(problem.m), "closed_pairs": int((states > OPEN).sum()),
         "contact_dofs": int(problem.n_contact_dofs),
         "mesh": fc.output.mesh_info(V, h_cylinder_m=geo["h_contact"],
                                     h_block_m=geo["h_block"], refine=args.refine),

@@ -28,6 +28,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
+from flexcontact.states import OPEN
 from flexcontact.contact_profile import approach_to_load, hertz_fit
 from flexcontact.meshes import hertz3d, tags
 
@@ -162,10 +163,10 @@ if comm.rank == 0:
         "approach_m": float(-top_z.value),
         "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
         "contact_pairs": int(problem.m),
-        "closed_pairs": int((states > 0).sum()),
+        "closed_pairs": int((states > OPEN).sum()),
         "contact_dofs": int(problem.n_contact_dofs),
         "candidate_zone_radius_m": geo["w"],
-        "outermost_closed_r_m": float(r[states > 0].max()),
+        "outermost_closed_r_m": float(r[states > OPEN].max()),
         "mesh": {"cells": int(msh.topology.index_map(3).size_global),
                  "dofs": int(V.dofmap.index_map.size_global * V.dofmap.index_map_bs),
                  "h_contact_m": geo["h_contact"], "h_far_m": geo["h_far"],

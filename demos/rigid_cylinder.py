@@ -22,6 +22,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import analytic, compat, forms
+from flexcontact.states import OPEN
 from flexcontact.contact_profile import approach_to_load, hertz_fit, profile
 from flexcontact.meshes import hertz2d, tags
 
@@ -93,7 +94,7 @@ if comm.rank == 0:
         "a": a_fit, "a_ref": a_ref, "a_error_rel": a_fit / a_ref - 1, "a_extent": a_extent,
         "p0": p0, "p0_ref": p0_ref, "p0_error_rel": p0 / p0_ref - 1,
         "max_penetration_rel": max(s.max_penetration_rel for s in summaries),
-        "contact_pairs": int(problem.m), "closed_pairs": int((states > 0).sum()),
+        "contact_pairs": int(problem.m), "closed_pairs": int((states > OPEN).sum()),
         "mesh": fc.output.mesh_info(V, h_contact_m=geo["h_contact"], refine=args.refine),
         **fc.output.run_record(problem, summaries, t_start),
         "profile": {"x": x, "pressure": p, "state": states},

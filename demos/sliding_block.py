@@ -18,6 +18,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import compat, forms
+from flexcontact.states import STICK
 from flexcontact.contact_profile import profile
 from flexcontact.meshes import block_on_base, tags
 
@@ -102,7 +103,7 @@ if comm.rank == 0:
     ratio = T / np.maximum(args.mu * N, 1e-300)
     stick_slip = []
     for inc in problem.increments:
-        st = inc.states == 1
+        st = inc.states == STICK
         stick_slip.append(float(np.abs(inc.slip_increment[st]).max(initial=0.0)))
     umax = max(1e-300, float(np.abs(problem.u.x.array).max()))
     summary = {

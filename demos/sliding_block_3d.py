@@ -40,6 +40,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import compat, forms
+from flexcontact.states import STICK
 from flexcontact.meshes import block_on_base, tags
 
 parser = argparse.ArgumentParser(description=__doc__)
@@ -197,7 +198,7 @@ if comm.rank == 0:
         g = np.einsum("kij,ki->kj", frames[:, 1:, :], inc.slip_increment)  # (m, 3) [m]
         mean = g[:, :2].mean(axis=0)
         slip_mean.append(mean)
-        st = inc.states == 1
+        st = inc.states == STICK
         stick_slip.append(float(np.linalg.norm(inc.slip_increment[st], axis=1).max(initial=0.0)))
         minus_T = -Tvec[i, :2]
         slip_vs_T.append(between_deg(minus_T, mean) if i in gross else np.nan)

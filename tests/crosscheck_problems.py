@@ -29,6 +29,14 @@ STEEL = forms.Material(E_Pa=200e9, nu=0.3, name="steel")
 ALUMINIUM = forms.Material(E_Pa=70e9, nu=0.33, name="aluminium")
 
 STATE_NAMES = ("open", "stick", "slip")
+"""The names of the pair states counted by ``state_counts``, in that order."""
+
+
+def state_counts(states) -> np.ndarray:
+    """How many pairs are open, stick and slip (flexcontact.states' codes)."""
+    from flexcontact.states import OPEN, SLIP, STICK
+    s = np.asarray(states)
+    return np.array([(s == OPEN).sum(), (s == STICK).sum(), (s == SLIP).sum()])
 
 
 @dataclass

@@ -19,6 +19,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from flexcontact import compat, forms
+from flexcontact.states import OPEN
 from flexcontact.memory import ENV_AVAILABLE, ENV_WORKING_SET, dense_bytes
 from flexcontact.meshes import hertz2d, hertz3d, tags
 
@@ -82,7 +83,7 @@ def test_factor_path_matches_dense_on_2d_hertz(mu, working_set, monkeypatch):
             assert scale > 0
             assert np.abs(a.lam - b.lam).max() <= AGREE * scale
             assert np.abs(a.gap - b.gap).max() <= AGREE * np.abs(a.gap).max()
-            assert np.array_equal(a.states > 0, b.states > 0)
+            assert np.array_equal(a.states > OPEN, b.states > OPEN)
             assert b.summary.solver == solver and b.summary.residual < 1e-10
             assert b.summary.iterations > 0
     if working_set is None:
@@ -90,7 +91,7 @@ def test_factor_path_matches_dense_on_2d_hertz(mu, working_set, monkeypatch):
         # pair that closed among them, and no single back-substitution in the local solve.
         assert fact.contact.block_columns == 2 * fact.contact.cached_pairs <= 2 * fact.m
         if MPI.COMM_WORLD.rank == 0:
-            closed = {k for inc in f_inc for k in np.flatnonzero(inc.states > 0)}
+            closed = {k for inc in f_inc for k in np.flatnonzero(inc.states > OPEN)}
             assert 0 < len(closed) <= fact.contact.cached_pairs
         assert fact.contact.applications == 0
 

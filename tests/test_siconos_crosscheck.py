@@ -117,8 +117,8 @@ def test_set_mixes_open_stick_and_slip():
         lu += s["lu_failures"]
         if len(s["attempts"]) > 1:
             fallbacks.append(s["case"].name)
-        ours = np.bincount(np.asarray(s["ours"].states), minlength=3)
-        sic = np.bincount(cp.states_of(s["case"], s["siconos"].lam), minlength=3)
+        ours = cp.state_counts(s["ours"].states)
+        sic = cp.state_counts(cp.states_of(s["case"], s["siconos"].lam))
         counts["ours"] += ours
         counts["siconos"] += sic
         cases_with += sic > 0

@@ -97,8 +97,8 @@ void flexcontact::bind_condensed(py::module& m)
           py::arg("up_c"), py::arg("e") = py::none(),
           "One increment from the contact-DOF values of u_p = K^-1 p (K^+ p with rigid modes, "
           "e = -R^T p then: the loads along them). Returns a dict: lambda, "
-          "gap (m x d, local frames), slip (m x d-1, this increment), states (0 open, 1 "
-          "stick, 2 slip), reaction (n_c, B^T lambda, zero on constrained DOFs), local_q, "
+          "gap (m x d, local frames), slip (m x d-1, this increment), states (1 open, 2 "
+          "stick, 3 slip), reaction (n_c, B^T lambda, zero on constrained DOFs), local_q, "
           "solution_c (n_c, u_p,c + F* r_c: the contact values of K^-1 (p + B^T lambda)), "
           "normal_force, tangential_force (d, global), max_penetration, pair_tangential "
           "(m x d, global), alpha (rigid-mode amplitudes), undetermined (k x r directions of "

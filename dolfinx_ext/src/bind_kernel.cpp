@@ -26,7 +26,7 @@ namespace
 {
 using IntArray = py::array_t<int, py::array::c_style | py::array::forcecast>;
 
-/// @brief Pair states as a numpy int array (0 open, 1 stick, 2 slip).
+/// @brief Pair states as a numpy int array (PairState's values: 1 open, 2 stick, 3 slip).
 py::array_t<int> states_to_array(const std::vector<PairState>& s)
 {
   py::array_t<int> a(s.size());
@@ -44,9 +44,9 @@ std::vector<PairState> states_from(const std::optional<IntArray>& a)
   for (py::ssize_t i = 0; i < a->size(); ++i)
   {
     int v = a->data()[i];
-    if (v < 0 or v > 2)
+    if (v < static_cast<int>(PairState::open) or v > static_cast<int>(PairState::slip))
       throw std::invalid_argument("pair state " + std::to_string(v)
-                                  + " is not 0 (open), 1 (stick) or 2 (slip)");
+                                  + " is not 1 (open), 2 (stick) or 3 (slip)");
     s.push_back(static_cast<PairState>(v));
   }
   return s;
@@ -198,10 +198,13 @@ namespace
 /// @brief problem.hpp: PairState, SolverOptions, SolveReport.
 void bind_problem(py::module& m)
 {
-  py::enum_<PairState>(m, "PairState", "Contact state of a pair")
+  py::enum_<PairState>(m, "PairState",
+                       "Contact state of a pair, one coding end to end (flexcontact.states)")
+      .value("none", PairState::none)
       .value("open", PairState::open)
       .value("stick", PairState::stick)
-      .value("slip", PairState::slip);
+      .value("slip", PairState::slip)
+      .value("crush", PairState::crush);
 
   py::class_<SolverOptions>(m, "SolverOptions", "Options shared by every local solver")
       .def(py::init<>())
@@ -363,7 +366,7 @@ void bind_residual(py::module& m)
         return states_to_array(classify_states(p, lambda, u, tol));
       },
       py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lam"),
-      py::arg("tol") = 1e-8, "Pair states (0 open, 1 stick, 2 slip) read from lambda");
+      py::arg("tol") = 1e-8, "Pair states (1 open, 2 stick, 3 slip) read from lambda");
 }
 
 /// @brief solvers.hpp: the chain and each local solver alone.
@@ -443,7 +446,7 @@ void bind_increment(py::module& m)
       .def("gap", [](const IncrementalSolver& s) { return s.gap(); }, "Total gap x of the last increment")
       .def("force", [](const IncrementalSolver& s) { return s.force(); }, "lambda of the last increment")
       .def("states", [](const IncrementalSolver& s) { return states_to_array(s.states()); },
-           "Pair states of the last increment (0 open, 1 stick, 2 slip)")
+           "Pair states of the last increment (1 open, 2 stick, 3 slip)")
       .def("last", [](const IncrementalSolver& s) { return s.last(); }, "Report of the last increment")
       .def("pairs", &IncrementalSolver::pairs)
       .def("dim", &IncrementalSolver::dim)

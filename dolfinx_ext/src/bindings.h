@@ -45,7 +45,7 @@ void bind_impact(pybind11::module& m);
 /// @brief A pair-by-pair vector (m·cols entries) as an m × cols array.
 pybind11::array_t<double> rows_of(const Vector& v, Eigen::Index cols);
 
-/// @brief Pair states as an int array (0 open, 1 stick, 2 slip).
+/// @brief Pair states as an int array (PairState's values: 1 open, 2 stick, 3 slip).
 pybind11::array_t<int> states_array(const std::vector<PairState>& s);
 
 /// @brief The pairs' local frames T_k as an m × d × d array (rows n, t (, t2)).

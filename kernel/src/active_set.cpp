@@ -181,6 +181,10 @@ void build_modified_system(const ProblemView& p, const std::vector<PairState>& s
         b[i + j] = 0.0;
       }
       break;
+    case PairState::none:
+    case PairState::crush:
+      throw std::logic_error("active set: pair " + std::to_string(k)
+                             + " has a state the active set does not take");
     }
   }
 }
@@ -256,6 +260,9 @@ PairState switch_pair(const ProblemView& p, int k, PairState state, const Vector
   case PairState::open:
     if (u[i] < -sw.gtol)
       return PairState::stick;
+    break;
+  case PairState::none:
+  case PairState::crush:
     break;
   }
   return state;

@@ -59,8 +59,8 @@ std::vector<PairState> read_states(std::istringstream& in)
   int v;
   while (in >> v)
   {
-    if (v < 0 || v > 2)
-      throw std::runtime_error("state " + std::to_string(v) + " is not 0, 1 or 2");
+    if (v < static_cast<int>(PairState::open) || v > static_cast<int>(PairState::slip))
+      throw std::runtime_error("state " + std::to_string(v) + " is not 1, 2 or 3");
     s.push_back(static_cast<PairState>(v));
   }
   return s;
@@ -98,7 +98,7 @@ Recorded read_recorded(const std::string& name)
     const std::size_t n = static_cast<std::size_t>(m) * r.dim;
     return static_cast<std::size_t>(m) + n * (n + 1) / 2 + 3 * n;
   };
-  StoredValues v = read_stored_values(path, "flexcontact-local-problem 1",
+  StoredValues v = read_stored_values(path, "flexcontact-local-problem 2",
                                       " (run tests/data/record.py)", on_line, count);
   const Eigen::Index n = static_cast<Eigen::Index>(m) * r.dim;
   r.mu = v.take(m);

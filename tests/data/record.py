@@ -65,7 +65,7 @@ def write(path, source, rec):
         raise RuntimeError(f"{path.name}: W is not exactly symmetric; the format keeps one half")
     m = rec["mu"].size
     header = [
-        "flexcontact-local-problem 1",
+        "flexcontact-local-problem 2",
         f"source {source}",
         f"dim {d}",
         f"pairs {m}",

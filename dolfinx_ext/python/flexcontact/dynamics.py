@@ -43,6 +43,7 @@ from .energy import EnergyAccount
 from .names import check_chain, check_flexibility_method, check_ordering
 from .pairing import pair_interfaces
 from .postprocess import ContactFields
+from .states import OPEN, SLIP, STICK
 from .stepper import Stepper, StepperViews
 from .errors import InputError
 
@@ -387,8 +388,8 @@ class ImpactProblem(StepperViews):
                 normal_force=float(out["normal_impulse"]) / self.dt,
                 slave_force=(np.asarray(out["slave_impulse"]) / self.dt).tolist(),
                 impulse=np.asarray(out["slave_impulse"]).tolist(),
-                active=int(closed.sum()), stick=int(((s == 1) & closed).sum()),
-                slip=int(((s == 2) & closed).sum()), open=int((s == 0).sum()),
+                active=int(closed.sum()), stick=int(((s == STICK) & closed).sum()),
+                slip=int(((s == SLIP) & closed).sum()), open=int((s == OPEN).sum()),
                 back_substitutions=solves, solver=str(rep["solver"]),
                 iterations=int(rep["iterations"]),
                 max_penetration_m=float(out["max_penetration"]))
@@ -416,7 +417,7 @@ class ImpactProblem(StepperViews):
                                   tangential=out["pair_tangential"] / self.dt)
         else:
             m = self.m if self.comm.rank == 0 else 0
-            inc = SimpleNamespace(lam=np.zeros((m, d)), states=np.zeros(m, int),
+            inc = SimpleNamespace(lam=np.zeros((m, d)), states=np.full(m, OPEN),
                                   tangential=np.zeros((m, d)))
         self.outputs.write_back(inc, self.pairs)
         f = self.outputs.all()

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 LAYERS = ("kernel", "base", "forms", "core", "meshes", "applications")
 
-_BASE = {"compat", "mpi", "names", "errors", "layers", "memory", "petsc_comm"}
+_BASE = {"compat", "mpi", "names", "errors", "layers", "memory", "petsc_comm", "states"}
 _APPLICATIONS = {"dam", "sweep", "__main__", "info"}
 
 

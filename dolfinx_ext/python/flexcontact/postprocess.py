@@ -15,11 +15,11 @@ from mpi4py import MPI
 import dolfinx.fem
 
 from . import compat
+from .states import OPEN, SLIP, STICK, STATE_NAMES  # noqa: F401  (STATE_NAMES: re-exported)
 from .writeback import set_nodal_values
 from .pairing import NodePairs
 from .errors import SolveError
 
-STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
 
 
 @dataclass
@@ -61,7 +61,7 @@ class IncrementResult:
     summary: IncrementSummary
     lam: np.ndarray        # (m, d) λ in the local frame (λ_n ≥ 0 compression) [N or N/m]
     gap: np.ndarray        # (m, d) total gap x in the local frame [m]
-    states: np.ndarray     # (m,) 0 open, 1 stick, 2 slip
+    states: np.ndarray     # (m,) states.OPEN, STICK or SLIP
     slip_increment: np.ndarray  # (m, d-1) tangential slip in this increment [m]
     tangential: Optional[np.ndarray] = None  # (m, d) friction force per pair, global axes
 
@@ -81,8 +81,8 @@ def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
             increment=number,
             normal_force=float(out["normal_force"]),
             tangential_force=out["tangential_force"].tolist(),
-            stick=int((states == 1).sum()), slip=int((states == 2).sum()),
-            open=int((states == 0).sum()),
+            stick=int((states == STICK).sum()), slip=int((states == SLIP).sum()),
+            open=int((states == OPEN).sum()),
             max_penetration_m=pen,
             max_penetration_rel=pen / umax if umax > 0 else 0.0,
             residual=float(rep["residual"]), iterations=int(rep["iterations"]),
@@ -97,14 +97,14 @@ def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
 
 
 def _nodal_contact(inc: IncrementResult, pairs):
-    """Pressure, tangential traction (global axes) and status (1 open, 2 stick, 3 slip) at
+    """Pressure, tangential traction (global axes) and status (states.py: OPEN, STICK, SLIP) at
     every contact node: a slave node carries its pair's force over its tributary measure,
     a master node the equal and opposite forces Σ_k w_kj (…) of the pairs that use it."""
     m, n = pairs.m, pairs.x.shape[0]
     masters, weights = pairs.masters, pairs.weights
     force_n = np.zeros(n)
     force_t = np.zeros((n, pairs.x.shape[1]))
-    state = np.zeros(n)
+    state = np.full(n, float(OPEN))
     force_n[:m] += inc.lam[:, 0]
     force_t[:m] += inc.tangential
     state[:m] = inc.states
@@ -115,7 +115,7 @@ def _nodal_contact(inc: IncrementResult, pairs):
         used = w > 0
         np.maximum.at(state, masters[used, j], inc.states[used].astype(float))
     area = np.where(pairs.node_area > 0, pairs.node_area, np.inf)
-    return force_n / area, force_t / area[:, None], state + 1.0
+    return force_n / area, force_t / area[:, None], state
 
 
 class ContactFields:

@@ -25,6 +25,7 @@ from ._cpp import SolverOptions
 from .assembly import assemble_load, assemble_stiffness
 from .condensation import Condensation
 from . import factor_path
+from .states import OPEN
 from .stepper import Stepper, StepperViews
 from .names import (PAIRINGS, ZONE_EDGE_ACTIONS, ContactOperator, FlexibilityMethod, Ordering,
                     Pairing, ZoneEdgeAction, check_chain, check_flexibility_method,
@@ -378,7 +379,7 @@ class ContactProblem(StepperViews):
             where = getattr(self.pairs, "interface", None)
             labels = []
             if edge is not None and where is not None:
-                hit = np.unique(where[(inc.states > 0) & edge])
+                hit = np.unique(where[(inc.states > OPEN) & edge])
                 labels = [self.interfaces[int(i)].label for i in hit]
         labels = self.comm.bcast(labels, root=0)
         inc.summary.zone_edge = labels

@@ -27,11 +27,15 @@ using Matrix = Eigen::MatrixXd;
 using Vector = Eigen::VectorXd;
 
 /// @brief Contact state of one pair (the seed's three states).
+/// The one coding of contact states, end to end: the kernel's pairs, the step results that
+/// cross to Python (flexcontact.states) and the output field contact_status.
 enum class PairState : int
 {
-  open = 0,  ///< no contact: λ = 0
-  stick = 1, ///< closed, no slip in the increment
-  slip = 2   ///< closed, sliding: λ_t on the boundary of the Coulomb cone
+  none = 0,  ///< not a contact node (output fields only; never a pair's state)
+  open = 1,  ///< no contact: λ = 0
+  stick = 2, ///< closed, no slip in the increment
+  slip = 3,  ///< closed, sliding: λ_t on the boundary of the Coulomb cone
+  crush = 4  ///< reserved for the crushing law (normal force at its cap)
 };
 
 /// @brief Read-only view of one local problem u = W λ + q with friction coefficients μ.
