@@ -209,6 +209,8 @@ def _check_bodies(V, interfaces: Sequence, surfaces: list, comm) -> None:
     """ValueError naming both tags when an interface's master surface lies on the slave's
     own body (a boundary tag mixed up with the master tag), or a SelfContactWarning where
     the interface says a self-contact is meant. Collective."""
+    if all(getattr(itf, "rigid", False) for itf in interfaces):
+        return  # a rigid target is no body of the mesh
     bs = V.dofmap.index_map_bs
     root = comm.rank == 0
     blocks, spans = [], []

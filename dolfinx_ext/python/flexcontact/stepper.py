@@ -80,10 +80,6 @@ class Stepper:
         return self.condensation.factor
 
     @property
-    def pairs(self):
-        return self.condensation.pairs
-
-    @property
     def split(self) -> bool:
         """True when a step is one back-substitution (the factor condenses and expands)."""
         return (not self.collective) and bool(getattr(self.factor, "has_condense", False))
