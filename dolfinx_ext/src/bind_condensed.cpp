@@ -122,8 +122,15 @@ void flexcontact::bind_condensed(py::module& m)
       .def("set_flexibility", &CondensedContact::set_flexibility, py::arg("F"),
            "New F* (e.g. another time step): W is rebuilt, pairs and history kept")
       .def("set_pairs", &CondensedContact::set_pairs, py::arg("pairs"), py::arg("mu"),
+           py::arg("cap") = Vector(),
            "New pairs: B, x0, W rebuilt from the stored F*; history reset, slip measured from "
-           "the new pairs' gap at the last contact displacement")
+           "the new pairs' gap at the last contact displacement; cap: the new pairs' normal "
+           "force caps of a crushable interface (empty: none)")
+      .def("set_crushing", &CondensedContact::set_crushing, py::arg("cap"),
+           "Caps of the pairs' normal forces [N; N/m in 2D] (inf: none, empty: no crushing)")
+      .def_property_readonly("node_crush_depth",
+                             [](const CondensedContact& c) { return c.node_crush_depth(); },
+                             "Crush depth of every contact node [m]")
       .def("set_rigid_modes", &CondensedContact::set_rigid_modes, py::arg("Rc"),
            "Rigid modes of the bodies held only by contact at the contact DOFs (n_c x k); "
            "G = B R_c borders the local problem")

@@ -92,6 +92,11 @@ py::dict condensed_step_dict(const CondensedStep& r, int dim)
   d["tangential_force"] = py::array_t<double>(r.tangential_force.size(),
                                               r.tangential_force.data());
   d["max_penetration"] = r.max_penetration;
+  if (r.crush_depth.size() > 0)
+  {
+    d["crush_depth"] = py::array_t<double>(r.crush_depth.size(), r.crush_depth.data());
+    d["crush_work"] = r.crush_work;
+  }
   const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> t
       = r.pair_tangential;
   d["pair_tangential"] = py::array_t<double>({t.rows(), t.cols()}, t.data());

@@ -44,6 +44,9 @@ py::dict step_dict(const ImpactStep& r, int dim)
   d["friction_work"] = r.friction_work;
   d["contact_work"] = r.contact_work;
   d["max_penetration"] = r.max_penetration;
+  d["crush_work"] = r.crush_work;
+  if (r.crush_depth.size() > 0)
+    d["crush_depth"] = py::array_t<double>(r.crush_depth.size(), r.crush_depth.data());
   d["active_pairs"] = r.active_pairs;
   d["report"] = report_dict(r.report);
   if (r.velocity_change_c.size() > 0)
@@ -88,7 +91,7 @@ void flexcontact::bind_impact(py::module& m)
           "velocity. Returns a dict: impulse, velocity (U+), velocity_before (U-), gap (m x d, "
           "local frames), states, active, reaction (n_c, B^T P), normal_impulse, "
           "slave_impulse (d, global), pair_tangential, friction_work, contact_work, "
-          "max_penetration, active_pairs, report")
+          "max_penetration, crush_work, crush_depth (with caps), active_pairs, report")
       .def(
           "step_condensed",
           [convergence_error](ImpactContact& c, const Vector& u_c, const Vector& v_c,
@@ -107,8 +110,16 @@ void flexcontact::bind_impact(py::module& m)
       .def("set_flexibility", &ImpactContact::set_flexibility, py::arg("F"), py::arg("dt_s"),
            "New F-hat (another time step): W_eff rebuilt, pairs kept")
       .def("set_pairs", &ImpactContact::set_pairs, py::arg("pairs"), py::arg("mu"),
+           py::arg("cap") = Vector(),
            "New pairs on the same contact nodes: B, x0, W_eff rebuilt from the stored F-hat; "
-           "pair k keeps its last impulse and state as warm start")
+           "pair k keeps its last impulse and state as warm start; cap: the new pairs' "
+           "force caps of a crushable interface (empty: none)")
+      .def("set_crushing", &ImpactContact::set_crushing, py::arg("cap"),
+           "Caps of the pairs' normal contact forces [N; N/m in 2D] (inf: none, empty: no "
+           "crushing); the impulse is capped at cap*dt and the surface crushes beyond it")
+      .def_property_readonly("node_crush_depth",
+                             [](const ImpactContact& c) { return c.node_crush_depth(); },
+                             "Crush depth of every contact node [m]")
       .def_property_readonly("B", [](const ImpactContact& c)
                              { return Eigen::SparseMatrix<double, Eigen::RowMajor>(c.B()); })
       .def_property_readonly("x0", [](const ImpactContact& c) { return c.x0(); })

@@ -325,6 +325,24 @@ void bind_pairs(py::module& m)
       "W = B F* B^T (symmetrised) with B given as COO triplets");
 }
 
+/// @brief The caps of a problem's normal forces (problem.hpp) as a view's pointer: null for
+/// none; checked to have one entry per pair, each > 0 (+inf: no cap).
+const double* cap_pointer(const std::optional<Vector>& cap, const Vector& q, int dim)
+{
+  if (!cap || cap->size() == 0)
+    return nullptr;
+  if (cap->size() * dim != q.size())
+    throw std::invalid_argument("cap has " + std::to_string(cap->size())
+                                + " entries; it needs one per pair (" + std::to_string(q.size() / dim)
+                                + ")");
+  for (Eigen::Index k = 0; k < cap->size(); ++k)
+    if (!((*cap)[k] > 0.0))
+      throw std::invalid_argument("cap[" + std::to_string(k) + "] is "
+                                  + std::to_string((*cap)[k])
+                                  + "; a normal force cap must be > 0 (inf: no cap)");
+  return cap->data();
+}
+
 /// @brief residual.hpp: the cone projection, the natural-map residual and the states.
 void bind_residual(py::module& m)
 {
@@ -341,32 +359,48 @@ void bind_residual(py::module& m)
       py::arg("r"), py::arg("mu"), "Projection of one pair's force onto the Coulomb cone");
 
   m.def(
+      "project_on_truncated_cone",
+      [](Vector r, double mu, double cap)
+      {
+        const int dim = static_cast<int>(r.size());
+        if (dim != 2 and dim != 3)
+          throw std::invalid_argument("a pair force has 2 or 3 entries");
+        project_on_truncated_cone(r.data(), dim, mu, cap);
+        return r;
+      },
+      py::arg("r"), py::arg("mu"), py::arg("cap"),
+      "Projection of one pair's force onto the Coulomb cone truncated at r_n <= cap");
+
+  m.def(
       "natural_map_residual",
-      [](int dim, const Matrix& W, const Vector& q, const Vector& mu, const Vector& lambda)
+      [](int dim, const Matrix& W, const Vector& q, const Vector& mu, const Vector& lambda,
+         const std::optional<Vector>& cap)
       {
         check_problem(dim, W, q, mu, lambda);
         if (lambda.size() != q.size())
           throw std::invalid_argument("lambda must have as many entries as q");
-        ProblemView p{dim, W, q, mu};
+        ProblemView p{dim, W, q, mu, cap_pointer(cap, q, dim)};
         return natural_map_residual(p, lambda);
       },
       py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lam"),
+      py::arg("cap") = py::none(),
       "Relative natural-map residual of lambda for u = W lambda + q (0 for a solution)");
 
   m.def(
       "classify_states",
       [](int dim, const Matrix& W, const Vector& q, const Vector& mu, const Vector& lambda,
-         double tol)
+         double tol, const std::optional<Vector>& cap)
       {
         check_problem(dim, W, q, mu, lambda);
         if (lambda.size() != q.size())
           throw std::invalid_argument("lambda must have as many entries as q");
-        ProblemView p{dim, W, q, mu};
+        ProblemView p{dim, W, q, mu, cap_pointer(cap, q, dim)};
         Vector u = W * lambda + q;
         return states_to_array(classify_states(p, lambda, u, tol));
       },
       py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"), py::arg("lam"),
-      py::arg("tol") = 1e-8, "Pair states (1 open, 2 stick, 3 slip) read from lambda");
+      py::arg("tol") = 1e-8, py::arg("cap") = py::none(),
+      "Pair states (1 open, 2 stick, 3 slip, 4 crush) read from lambda");
 }
 
 /// @brief solvers.hpp: the chain and each local solver alone.
@@ -380,18 +414,18 @@ void bind_solvers(py::module& m)
         name,
         [solver](int dim, const Matrix& W, const Vector& q, const Vector& mu,
                  const std::optional<Vector>& lambda0, const std::optional<IntArray>& states0,
-                 const SolverOptions& options)
+                 const SolverOptions& options, const std::optional<Vector>& cap)
         {
           Vector l0 = or_empty(lambda0);
           auto s0 = states_from(states0);
           check_problem(dim, W, q, mu, l0, s0.size());
-          ProblemView p{dim, W, q, mu};
+          ProblemView p{dim, W, q, mu, cap_pointer(cap, q, dim)};
           py::gil_scoped_release release;
           return solver(p, l0, s0, options);
         },
         py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"),
         py::arg("lambda0") = py::none(), py::arg("states0") = py::none(),
-        py::arg("options") = SolverOptions(), doc);
+        py::arg("options") = SolverOptions(), py::arg("cap") = py::none(), doc);
   };
   using States = std::vector<PairState>;
   def_solver(
@@ -446,8 +480,14 @@ void bind_increment(py::module& m)
       .def("gap", [](const IncrementalSolver& s) { return s.gap(); }, "Total gap x of the last increment")
       .def("force", [](const IncrementalSolver& s) { return s.force(); }, "lambda of the last increment")
       .def("states", [](const IncrementalSolver& s) { return states_to_array(s.states()); },
-           "Pair states of the last increment (1 open, 2 stick, 3 slip)")
+           "Pair states of the last increment (1 open, 2 stick, 3 slip, 4 crush)")
       .def("last", [](const IncrementalSolver& s) { return s.last(); }, "Report of the last increment")
+      .def("set_crushing", &IncrementalSolver::set_crushing, py::arg("cap"),
+           py::arg("crush_depth"),
+           "Caps of the pairs' normal forces (inf: none) and their crush depths so far [m]")
+      .def_property_readonly("crush_depth",
+                             [](const IncrementalSolver& s) { return s.crush_depth(); })
+      .def_property_readonly("crush_work", &IncrementalSolver::crush_work)
       .def("pairs", &IncrementalSolver::pairs)
       .def("dim", &IncrementalSolver::dim)
       .def_property_readonly("W", [](const IncrementalSolver& s) { return s.W(); });

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -50,15 +51,21 @@ private:
 /// Jacobian; the generalised Jacobian of Φ is then I − dP (I − diag(ρ_n, ρ_t…) ∂u/∂λ).
 /// Separate normal and tangential ρ keep the map well scaled when the pair's block is
 /// strongly anisotropic; any ρ_n, ρ_t > 0 give the same solutions.
+///
+/// With a cap c on the normal force (problem.hpp) the normal part is clamped to [0, c],
+/// λ_n − min(max(0, z_n), c), and the disc's radius is μ times that clamped value; c = +∞
+/// is the uncapped function, bitwise.
 inline void ac_pair(const double* lam, const double* u, double mu, double rho_n, double rho_t,
-                    int d, double* phi, double* dP)
+                    int d, double* phi, double* dP,
+                    double cap = std::numeric_limits<double>::infinity())
 {
   double z[3] = {0.0, 0.0, 0.0};
   z[0] = lam[0] - rho_n * u[0];
   for (int i = 1; i < d; ++i)
     z[i] = lam[i] - rho_t * u[i];
-  const double xi = z[0] > 0.0 ? z[0] : 0.0;
+  const double xi = z[0] > 0.0 ? (z[0] > cap ? cap : z[0]) : 0.0;
   const double r = mu * xi;
+  const bool free_normal = z[0] > 0.0 && !(z[0] > cap); // ∂ξ/∂z_n = 1
   // sqrt, not hypot: 5% of a chain solve under callgrind; z is a force (λ − ρu), far from
   // the overflow range hypot guards against.
   const double zt = d == 2 ? std::abs(z[1]) : std::sqrt(z[1] * z[1] + z[2] * z[2]);
@@ -76,7 +83,7 @@ inline void ac_pair(const double* lam, const double* u, double mu, double rho_n,
     return;
   for (int i = 0; i < d * d; ++i)
     dP[i] = 0.0;
-  dP[0] = z[0] > 0.0 ? 1.0 : 0.0;
+  dP[0] = free_normal ? 1.0 : 0.0;
   if (inside)
   {
     for (int i = 1; i < d; ++i)
@@ -84,11 +91,11 @@ inline void ac_pair(const double* lam, const double* u, double mu, double rho_n,
   }
   else if (zt > 0.0)
   {
-    // P_t = μ ξ ẑ: ∂/∂z_t = (r/|z_t|)(I − ẑẑᵀ), ∂/∂z_n = μ ẑ where z_n > 0.
+    // P_t = μ ξ ẑ: ∂/∂z_t = (r/|z_t|)(I − ẑẑᵀ), ∂/∂z_n = μ ẑ where 0 < z_n < cap.
     for (int i = 1; i < d; ++i)
     {
       const double hi = z[i] / zt;
-      if (z[0] > 0.0)
+      if (free_normal)
         dP[i * d] = mu * hi;
       for (int j = 1; j < d; ++j)
         dP[i * d + j] = s * ((i == j ? 1.0 : 0.0) - hi * z[j] / zt);
@@ -172,5 +179,10 @@ inline void check_problem(const ProblemView& p, const Eigen::Ref<const Vector>& 
     if (!(p.mu[k] >= 0.0) || !std::isfinite(p.mu[k]))
       throw std::invalid_argument(w + "mu of pair " + std::to_string(k)
                                   + " is negative or not finite");
+  for (int k = 0; p.cap && k < p.pairs(); ++k)
+    if (!(p.cap[k] > 0.0))
+      throw std::invalid_argument(w + "the normal force cap of pair " + std::to_string(k)
+                                  + " is " + std::to_string(p.cap[k])
+                                  + "; it must be > 0 (+inf: no cap)");
 }
 } // namespace flexcontact::detail

@@ -105,16 +105,19 @@ Eigen::VectorXd tangent(const Vector& v, int k, int d)
 
 /// @brief The discrete part of the iteration: states, and the slip directions that enter
 /// the system (2D signs exactly, 3D directions rounded), for revisit detection.
-std::vector<std::int64_t> state_key(const std::vector<PairState>& states, const Matrix& dir,
+std::vector<std::int64_t> state_key(const std::vector<PairState>& states,
+                                    const std::vector<char>& crush_slip, const Matrix& dir,
                                     const Eigen::Ref<const Vector>& mu)
 {
   std::vector<std::int64_t> key;
   key.reserve(states.size() * 3);
   for (std::size_t k = 0; k < states.size(); ++k)
   {
-    key.push_back(static_cast<std::int64_t>(states[k]));
+    const bool crushing = states[k] == PairState::crush;
+    key.push_back(static_cast<std::int64_t>(states[k]) + (crushing && crush_slip[k] ? 10 : 0));
     // A direction changes the system only for a slipping pair with friction.
-    if (states[k] != PairState::slip || mu[static_cast<Eigen::Index>(k)] == 0.0)
+    const bool slipping = states[k] == PairState::slip || (crushing && crush_slip[k]);
+    if (!slipping || mu[static_cast<Eigen::Index>(k)] == 0.0)
       continue;
     for (Eigen::Index j = 0; j < dir.rows(); ++j)
       key.push_back(static_cast<std::int64_t>(std::llround(dir(j, k) * 1e6)));
@@ -144,13 +147,19 @@ Eigen::VectorXd initial_direction(const ProblemView& p, const Vector& lambda, co
 
 const char* state_name(PairState s)
 {
-  return s == PairState::open ? "open" : s == PairState::stick ? "stick" : "slip";
+  return s == PairState::open    ? "open"
+         : s == PairState::stick ? "stick"
+         : s == PairState::slip  ? "slip"
+                                 : "crush";
 }
 
 /// @brief Fills A and b with the modified system: each pair's state replaces its rows of
-/// u = W λ + q. The rows that state a force are scaled by c_k (see row_scales).
+/// u = W λ + q. The rows that state a force are scaled by c_k (see row_scales). A crushing
+/// pair (docs/crushing.md) has its normal force at the cap, λ_n = cap, and tangential rows
+/// as a stick pair's (u_t = 0) or, where crush_slip, as a slip pair's.
 void build_modified_system(const ProblemView& p, const std::vector<PairState>& states,
-                           const Matrix& dir, const Vector& c, Matrix& A, Vector& b)
+                           const std::vector<char>& crush_slip, const Matrix& dir,
+                           const Vector& c, Matrix& A, Vector& b)
 {
   const int d = p.dim;
   for (int k = 0; k < p.pairs(); ++k)
@@ -158,6 +167,26 @@ void build_modified_system(const ProblemView& p, const std::vector<PairState>& s
     const int i = k * d;
     switch (states[k])
     {
+    case PairState::crush:
+      A.row(i).setZero();
+      A(i, i) = c[k];
+      b[i] = c[k] * p.cap_of(k);
+      for (int j = 1; j < d; ++j)
+      {
+        if (crush_slip[k])
+        {
+          A.row(i + j).setZero();
+          A(i + j, i + j) = c[k];
+          A(i + j, i) = c[k] * p.mu[k] * dir(j - 1, k);
+          b[i + j] = 0.0;
+        }
+        else
+        {
+          A.row(i + j) = p.W.row(i + j);
+          b[i + j] = -p.q[i + j];
+        }
+      }
+      break;
     case PairState::stick: // u_k = 0: the pair's rows of W λ + q
       A.middleRows(i, d) = p.W.middleRows(i, d);
       b.segment(i, d) = -p.q.segment(i, d);
@@ -182,7 +211,6 @@ void build_modified_system(const ProblemView& p, const std::vector<PairState>& s
       }
       break;
     case PairState::none:
-    case PairState::crush:
       throw std::logic_error("active set: pair " + std::to_string(k)
                              + " has a state the active set does not take");
     }
@@ -223,14 +251,35 @@ void update_slip_direction(const ProblemView& p, int k, double ln, const Eigen::
 /// its state in the system just solved. May update the pair's slip direction.
 PairState switch_pair(const ProblemView& p, int k, PairState state, const Vector& lambda,
                       const Vector& u, const Vector& c, const SwitchParams& sw, Matrix& dir,
-                      double& turn)
+                      double& turn, char& crush_slip)
 {
   const int d = p.dim;
   const int i = k * d;
   const double ln = lambda[i];
+  const double cap = p.cap_of(k);
   const Eigen::VectorXd lt = tangent(lambda, k, d), ut = tangent(u, k, d);
+  // A closed pair whose normal force passes its cap crushes, keeping its tangential state.
+  if ((state == PairState::stick || state == PairState::slip) && ln > cap + sw.ftol)
+  {
+    crush_slip = state == PairState::slip;
+    return PairState::crush;
+  }
   switch (state)
   {
+  case PairState::crush:
+    // At the cap the surface may not separate: a pair opening there unloads from the cap.
+    if (u[i] > sw.gtol)
+      return crush_slip ? PairState::slip : PairState::stick;
+    if (!crush_slip && lt.norm() > p.mu[k] * cap + sw.ftol && lt.norm() > sw.ftol)
+    {
+      dir.col(k) = -lt / lt.norm();
+      crush_slip = 1;
+    }
+    else if (crush_slip && p.mu[k] > 0.0 && ut.dot(dir.col(k)) < -sw.gtol)
+      crush_slip = 0;
+    else if (crush_slip && d == 3 && p.mu[k] > 0.0 && ut.norm() > sw.gtol)
+      update_slip_direction(p, k, cap, ut, c, sw.omega, dir, turn);
+    break;
   case PairState::stick:
     // Slip is tried before open: a stuck pair pulled apart (λ_n < 0) while sheared
     // may well be sliding, and going straight to open is what makes the plain
@@ -262,7 +311,6 @@ PairState switch_pair(const ProblemView& p, int k, PairState state, const Vector
       return PairState::stick;
     break;
   case PairState::none:
-  case PairState::crush:
     break;
   }
   return state;
@@ -272,13 +320,17 @@ PairState switch_pair(const ProblemView& p, int k, PairState state, const Vector
 /// and raises turn to the largest change of a 3D slip direction.
 int switch_states(const ProblemView& p, const Vector& lambda, const Vector& u, const Vector& c,
                   const SwitchParams& sw, int iteration, bool verbose,
-                  std::vector<PairState>& states, Matrix& dir, double& turn)
+                  std::vector<PairState>& states, std::vector<char>& crush_slip, Matrix& dir,
+                  double& turn)
 {
   int changes = 0;
   for (int k = 0; k < p.pairs(); ++k)
   {
     const PairState old = states[k];
-    states[k] = switch_pair(p, k, old, lambda, u, c, sw, dir, turn);
+    const char old_slip = crush_slip[k];
+    states[k] = switch_pair(p, k, old, lambda, u, c, sw, dir, turn, crush_slip[k]);
+    if (states[k] == PairState::crush && old == PairState::crush && crush_slip[k] != old_slip)
+      ++changes;
     if (states[k] != old)
     {
       ++changes;
@@ -296,9 +348,9 @@ int switch_states(const ProblemView& p, const Vector& lambda, const Vector& u, c
 class CycleDetector
 {
 public:
-  CycleDetector(const std::vector<PairState>& states, const Matrix& dir,
-                const Eigen::Ref<const Vector>& mu)
-      : last_key_(state_key(states, dir, mu))
+  CycleDetector(const std::vector<PairState>& states, const std::vector<char>& crush_slip,
+                const Matrix& dir, const Eigen::Ref<const Vector>& mu)
+      : last_key_(state_key(states, crush_slip, dir, mu))
   {
     seen_.insert(last_key_);
   }
@@ -308,10 +360,11 @@ public:
 
   /// @brief Records the states and directions after a switching pass that made `changes`
   /// changes; true if the iteration cycles.
-  bool cycles(const std::vector<PairState>& states, const Matrix& dir,
-              const Eigen::Ref<const Vector>& mu, int changes, int iteration, bool verbose)
+  bool cycles(const std::vector<PairState>& states, const std::vector<char>& crush_slip,
+              const Matrix& dir, const Eigen::Ref<const Vector>& mu, int changes, int iteration,
+              bool verbose)
   {
-    auto key = state_key(states, dir, mu);
+    auto key = state_key(states, crush_slip, dir, mu);
     const bool same_as_last = (key == last_key_);
     last_key_ = key;
     if (changes == 0 && same_as_last)
@@ -324,7 +377,7 @@ public:
       // about the answer. Relax it and forget the directions seen so far.
       omega_ *= 0.5;
       seen_.clear();
-      seen_.insert(state_key(states, dir, mu));
+      seen_.insert(state_key(states, crush_slip, dir, mu));
       if (verbose)
         std::cerr << "active_set: iteration " << iteration
                   << ": slip directions oscillate; relaxation " << omega_ << "\n";
@@ -367,9 +420,13 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
   rep.solver = "active_set";
   Vector lambda = lambda0.size() ? Vector(lambda0) : Vector(Vector::Zero(n));
   Vector u = p.W * lambda + p.q;
-
   std::vector<PairState> states
       = states0.empty() ? std::vector<PairState>(m, PairState::stick) : states0;
+  // A start that crushes where there is no cap (any more) starts stuck instead.
+  for (int k = 0; k < m; ++k)
+    if (states[k] == PairState::crush && !(p.cap_of(k) < std::numeric_limits<double>::infinity()))
+      states[k] = PairState::stick;
+  std::vector<char> crush_slip(static_cast<std::size_t>(m), 0);
   Matrix dir = Matrix::Zero(d - 1, m); // unit slip direction in the pair's tangent plane
   for (int k = 0; k < m; ++k)
     dir.col(k) = initial_direction(p, lambda, u, k);
@@ -384,14 +441,14 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
 
   Vector best_lambda = lambda;
   double best_residual = natural_map_residual(p, lambda);
-  CycleDetector detector(states, dir, p.mu);
+  CycleDetector detector(states, crush_slip, dir, p.mu);
 
   Matrix A(n, n);
   Vector b(n), x(n);
   const detail::Deadline deadline(opt.time_budget_s);
   while (rep.iterations < opt.max_iterations && !deadline.passed())
   {
-    build_modified_system(p, states, dir, c, A, b);
+    build_modified_system(p, states, crush_slip, dir, c, A, b);
     ++rep.iterations;
     if (!solve_dense(A, b, x))
     {
@@ -415,7 +472,8 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
     const SwitchParams sw{tau * fscale, tau * gscale, detector.omega()};
     double turn = 0.0;
     const int changes
-        = switch_states(p, lambda, u, c, sw, rep.iterations, opt.verbose, states, dir, turn);
+        = switch_states(p, lambda, u, c, sw, rep.iterations, opt.verbose, states, crush_slip,
+                        dir, turn);
     rep.state_changes += changes;
     if (opt.verbose)
       std::cerr << "active_set: iteration " << rep.iterations << ": " << changes
@@ -425,7 +483,7 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
       break; // certified: nothing left to switch that matters
     if (changes == 0 && turn <= 1e-14)
       break; // fixed point of states and directions (uncertified if res > tolerance)
-    if (detector.cycles(states, dir, p.mu, changes, rep.iterations, opt.verbose))
+    if (detector.cycles(states, crush_slip, dir, p.mu, changes, rep.iterations, opt.verbose))
     {
       rep.cycled = true;
       break;

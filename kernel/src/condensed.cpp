@@ -13,6 +13,7 @@
 #include "step_summary.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +42,22 @@ CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
   solver_ = IncrementalSolver(dim_, delassus(B_, F_), mu_, options_);
   solver_.set_initial_gap(x0_);
   R_ = Matrix::Zero(n_c, 0);
+  crush_node_ = Vector::Zero(X_.rows());
+}
+
+void CondensedContact::set_crushing(Vector cap)
+{
+  if (cap.size() == 0)
+  {
+    cap_ = Vector();
+    solver_.set_crushing(Vector(), Vector());
+    return;
+  }
+  Vector depth(pairs());
+  for (int k = 0; k < pairs(); ++k)
+    depth[k] = crush_node_[pairs_[static_cast<std::size_t>(k)].slave];
+  solver_.set_crushing(cap, depth); // checks sizes and values
+  cap_ = std::move(cap);
 }
 
 void CondensedContact::set_rigid_modes(Matrix Rc)
@@ -62,9 +79,12 @@ void CondensedContact::set_flexibility(Matrix Fstar)
   F_ = std::move(Fstar);
 }
 
-void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
+void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
 {
   detail::check_mu_count(mu, pairs.size(), who);
+  if (cap.size() != 0 && cap.size() != static_cast<Eigen::Index>(pairs.size()))
+    throw std::invalid_argument(who + "set_pairs: cap has " + std::to_string(cap.size())
+                                + " entries for " + std::to_string(pairs.size()) + " pairs");
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
@@ -78,11 +98,19 @@ void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   }
   if (R_.cols())
     solver.set_border(B * R_);
+  if (cap.size())
+  {
+    Vector depth(cap.size());
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      depth[static_cast<Eigen::Index>(k)] = crush_node_[pairs[k].slave];
+    solver.set_crushing(cap, depth);
+  }
   B_ = std::move(B);
   x0_ = std::move(x0);
   solver_ = std::move(solver);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
+  cap_ = std::move(cap);
 }
 
 std::string CondensedContact::held_and_penetrating(const Vector& q) const
@@ -99,7 +127,8 @@ std::string CondensedContact::held_and_penetrating(const Vector& q) const
   const double scale = std::max(q.size() ? q.cwiseAbs().maxCoeff() : 0.0, 1e-300);
   int count = 0, first = -1;
   for (int k = 0; k < m; ++k)
-    if (W(k * dim_, k * dim_) <= rigid && q[k * dim_] < -1e-12 * scale)
+    if (W(k * dim_, k * dim_) <= rigid && q[k * dim_] < -1e-12 * scale
+        && !(cap_.size() && cap_[k] < std::numeric_limits<double>::infinity()))
     {
       if (count++ == 0)
         first = k;
@@ -163,6 +192,13 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
   r.lambda = solver_.force();
   r.gap = solver_.gap();
   r.states = solver_.states();
+  if (cap_.size())
+  {
+    r.crush_depth = solver_.crush_depth();
+    r.crush_work = solver_.crush_work();
+    for (int k = 0; k < pairs(); ++k)
+      crush_node_[pairs_[static_cast<std::size_t>(k)].slave] = r.crush_depth[k];
+  }
 
   detail::summarize_step(r, pairs_, dim_, previous, B_, constrained_);
   r.solution_c = up_c + F_ * r.reaction;

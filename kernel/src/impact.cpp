@@ -40,6 +40,20 @@ void check_vector(const char* name, const Eigen::Ref<const Vector>& v, Eigen::In
 {
   detail::check_contact_values(who + "step: ", name, v, n);
 }
+
+/// @brief Throws unless cap is empty or has m entries, each > 0 (+∞ allowed).
+void check_cap(const Vector& cap, std::size_t m)
+{
+  if (cap.size() == 0)
+    return;
+  if (cap.size() != static_cast<Eigen::Index>(m))
+    throw std::invalid_argument(who + "cap has " + std::to_string(cap.size()) + " entries for "
+                                + std::to_string(m) + " pairs");
+  for (Eigen::Index k = 0; k < cap.size(); ++k)
+    if (!(cap[k] > 0.0))
+      throw std::invalid_argument(who + "the force cap of pair " + std::to_string(k) + " is "
+                                  + num(cap[k]) + "; it must be > 0 (+inf: no cap)");
+}
 } // namespace
 
 ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<ContactPair> pairs,
@@ -66,6 +80,13 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   W_ = delassus(B_, F_);
   last_P_ = Vector::Zero(static_cast<Eigen::Index>(pairs_.size()) * dim_);
   last_states_.assign(pairs_.size(), PairState::open);
+  crush_node_ = Vector::Zero(X_.rows());
+}
+
+void ImpactContact::set_crushing(Vector cap)
+{
+  check_cap(cap, pairs_.size());
+  cap_ = std::move(cap);
 }
 
 void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
@@ -78,9 +99,10 @@ void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
   dt_ = dt_s;
 }
 
-void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
+void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
 {
   check_mu(mu, pairs.size());
+  check_cap(cap, pairs.size());
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
@@ -95,6 +117,7 @@ void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   W_ = std::move(W);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
+  cap_ = std::move(cap);
 }
 
 ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
@@ -113,7 +136,7 @@ ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
   for (int k = 0; k < m; ++k)
   {
     // Predicted gap at θ of the step: pairs that may close within it take part.
-    const double predicted = r.gap[k * d] + dt_ * theta_ * r.velocity_before[k * d];
+    const double predicted = r.gap[k * d] + crush_of(k) + dt_ * theta_ * r.velocity_before[k * d];
     r.active[k] = predicted <= 0.0;
     r.active_pairs += r.active[k] ? 1 : 0;
   }
@@ -129,6 +152,8 @@ ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
   }
   r.velocity = W_ * r.impulse + Ufree;
   finish(r);
+  if (cap_.size())
+    crush(r);
   last_P_ = r.impulse;
   last_states_ = r.states;
   return r;
@@ -188,7 +213,14 @@ void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
     mu[a] = mu_[act[a]];
     s0[a] = last_states_[act[a]] == PairState::open ? PairState::stick : last_states_[act[a]];
   }
-  const ProblemView view{d, W, q, mu};
+  Vector cap;
+  if (cap_.size())
+  {
+    cap.resize(static_cast<Eigen::Index>(act.size()));
+    for (std::size_t a = 0; a < act.size(); ++a)
+      cap[static_cast<Eigen::Index>(a)] = cap_[act[a]] * dt_; // a cap on the impulse
+  }
+  const ProblemView view{d, W, q, mu, cap.size() ? cap.data() : nullptr};
   SolveReport rep = solve(view, P0, s0, options_);
   if (!rep.converged)
   {
@@ -221,7 +253,7 @@ void ImpactContact::finish(ImpactStep& r) const
     const Matrix& T = pairs_[k].frame;
     r.normal_impulse += r.impulse[k * d];
     r.slave_impulse += T.transpose() * r.impulse.segment(k * d, d);
-    min_gap = std::min(min_gap, r.gap[k * d]);
+    min_gap = std::min(min_gap, r.gap[k * d] + crush_of(k));
     for (int j = 1; j < d; ++j)
     {
       r.pair_tangential.row(k) += r.impulse[k * d + j] * T.row(j);
@@ -234,5 +266,28 @@ void ImpactContact::finish(ImpactStep& r) const
   for (std::size_t i = 0; i < constrained_.size(); ++i)
     if (constrained_[i])
       r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+}
+
+double ImpactContact::crush_of(int k) const
+{
+  return cap_.size() ? crush_node_[pairs_[static_cast<std::size_t>(k)].slave] : 0.0;
+}
+
+void ImpactContact::crush(ImpactStep& r)
+{
+  // The surface crushes at the rate the pair closes while its impulse is at the cap: over
+  // the step, h max(0, −U_n^θ), with the θ-velocity of the scheme's energy balance, so that
+  // the crushing work is exactly the crushing pairs' part of contact_work.
+  const int d = dim_;
+  const Vector Utheta = theta_ * r.velocity + (1.0 - theta_) * r.velocity_before;
+  for (int k = 0; k < pairs(); ++k)
+    if (r.states[k] == PairState::crush && Utheta[k * d] < 0.0)
+    {
+      crush_node_[pairs_[static_cast<std::size_t>(k)].slave] += -dt_ * Utheta[k * d];
+      r.crush_work += -r.impulse[k * d] * Utheta[k * d];
+    }
+  r.crush_depth.resize(pairs());
+  for (int k = 0; k < pairs(); ++k)
+    r.crush_depth[k] = crush_of(k);
 }
 } // namespace flexcontact

@@ -122,6 +122,34 @@ void IncrementalSolver::set_warm_start(Vector lambda, std::vector<PairState> sta
   states_ = std::move(states);
 }
 
+void IncrementalSolver::set_crushing(Vector cap, Vector crush_depth)
+{
+  const std::string who = "flexcontact: IncrementalSolver::set_crushing: ";
+  if (cap.size() == 0 && crush_depth.size() == 0)
+  {
+    cap_ = Vector();
+    crush_ = Vector();
+    return;
+  }
+  if (cap.size() != pairs() || crush_depth.size() != pairs())
+    throw std::invalid_argument(who + "cap has " + std::to_string(cap.size())
+                                + " and crush_depth " + std::to_string(crush_depth.size())
+                                + " entries, expected one per pair (" + std::to_string(pairs())
+                                + ")");
+  for (int k = 0; k < pairs(); ++k)
+  {
+    if (!(cap[k] > 0.0))
+      throw std::invalid_argument(who + "the cap of pair " + std::to_string(k) + " is "
+                                  + num(cap[k]) + "; it must be > 0 (+inf: no cap)");
+    if (!(crush_depth[k] >= 0.0) || !std::isfinite(crush_depth[k]))
+      throw std::invalid_argument(who + "the crush depth of pair " + std::to_string(k)
+                                  + " is " + num(crush_depth[k])
+                                  + " m; it must be finite and >= 0");
+  }
+  cap_ = std::move(cap);
+  crush_ = std::move(crush_depth);
+}
+
 Vector IncrementalSolver::local_q(const Eigen::Ref<const Vector>& q_total) const
 {
   // The slip of this increment is x_t − x_t,prev: remove the previous tangential gap.
@@ -129,6 +157,9 @@ Vector IncrementalSolver::local_q(const Eigen::Ref<const Vector>& q_total) const
   for (int k = 0; k < pairs(); ++k)
     for (int j = 1; j < dim_; ++j)
       q[k * dim_ + j] -= x_[k * dim_ + j];
+  // The crushed surface is δ behind the elastic one.
+  for (Eigen::Index k = 0; k < crush_.size(); ++k)
+    q[k * dim_] += crush_[k];
   return q;
 }
 
@@ -151,11 +182,17 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
     throw std::invalid_argument(who + "e (the loads along the rigid modes) is not finite");
 
   const Vector q = local_q(q_total);
-  const ProblemView view{dim_, W_, q, mu_};
+  const ProblemView view{dim_, W_, q, mu_, cap_.size() ? cap_.data() : nullptr};
   SolveReport r = G_.cols() ? solve(view, G_, e, lambda_, alpha_, options_)
                             : solve(view, lambda_, states_, options_);
   if (!r.converged)
   {
+    // A load the capped forces cannot carry has no answer to converge to: say that first.
+    if (r.attempts.size() == 1 && r.attempts.front().rfind("no equilibrium", 0) == 0)
+    {
+      const std::string what = "flexcontact: " + r.attempts.front();
+      throw ConvergenceError(what, std::move(r));
+    }
     std::string what = "flexcontact: increment did not converge; best residual "
                        + num(r.residual) + " (tolerance " + num(options_.tolerance)
                        + ") from " + r.solver + ". Tried:";
@@ -171,6 +208,13 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
   }
   lambda_ = r.lambda;
   states_ = r.states;
+  crush_work_ = 0.0;
+  for (Eigen::Index k = 0; k < crush_.size(); ++k)
+    if (states_[static_cast<std::size_t>(k)] == PairState::crush && -x_[k * dim_] > crush_[k])
+    {
+      crush_work_ += lambda_[k * dim_] * (-x_[k * dim_] - crush_[k]);
+      crush_[k] = -x_[k * dim_];
+    }
   last_ = std::move(r);
   return last_;
 }

@@ -54,7 +54,8 @@ void evaluate(const Bordered& b, Iterate& s)
   s.dP.resize(static_cast<std::size_t>(b.p.pairs()) * d * d);
   for (int k = 0; k < b.p.pairs(); ++k)
     detail::ac_pair(s.lam.data() + k * d, s.u.data() + k * d, b.p.mu[k], b.rho[k],
-                    b.rho_t[k], d, s.phi.data() + k * d, s.dP.data() + k * d * d);
+                    b.rho_t[k], d, s.phi.data() + k * d, s.dP.data() + k * d * d,
+                    b.p.cap_of(k));
   s.psi = b.G.transpose() * s.lam - b.e;
   s.f = 0.5 * (s.phi.squaredNorm() + s.psi.squaredNorm());
 }
@@ -63,7 +64,7 @@ void evaluate(const Bordered& b, Iterate& s)
 /// equilibrium residual.
 double residual(const Bordered& b, const Iterate& s)
 {
-  const ProblemView v{b.p.dim, b.p.W, s.qe, b.p.mu};
+  const ProblemView v{b.p.dim, b.p.W, s.qe, b.p.mu, b.p.cap};
   const double contact = natural_map_residual(v, s.lam);
   const Vector held = b.G.cwiseAbs().transpose() * s.lam.cwiseAbs();
   const double scale = std::max({b.e.norm(), held.norm(), 1e-300});
@@ -272,7 +273,7 @@ SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const M
   rep.u = s.u;
   rep.residual = res;
   rep.converged = res <= opt.tolerance;
-  const ProblemView v{p.dim, p.W, s.qe, p.mu};
+  const ProblemView v{p.dim, p.W, s.qe, p.mu, p.cap};
   rep.states = classify_states(v, rep.lambda, rep.u);
   rep.attempts.push_back("newton_ac (bordered" + std::string(cold ? ", all-stick start" : "")
                          + "): " + (rep.converged ? "converged" : "not converged") + " in "
@@ -281,6 +282,44 @@ SolveReport solve_newton_bordered(const ProblemView& p, const Eigen::Ref<const M
   return rep;
 }
 
+namespace
+{
+/// @brief Empty, or why the capped contact forces cannot balance the loads e: along some
+/// rigid mode i, (Gᵀλ)_i over the truncated cones (problem.hpp) spans at most
+/// [Σ_k min(0, c_k (a_n − μ|a_t|)), Σ_k max(0, c_k (a_n + μ|a_t|))] with a = G's rows of
+/// pair k in column i, and e_i lies outside. Modes that an uncapped pair can carry either
+/// way are not judged.
+std::string no_equilibrium(const ProblemView& p, const Eigen::Ref<const Matrix>& G,
+                           const Eigen::Ref<const Vector>& e)
+{
+  const int d = p.dim;
+  for (Eigen::Index i = 0; i < G.cols(); ++i)
+  {
+    double hi = 0.0, lo = 0.0;
+    for (int k = 0; k < p.pairs(); ++k)
+    {
+      const double an = G(k * d, i);
+      const double at = d == 2 ? std::abs(G(k * d + 1, i)) : std::hypot(G(k * d + 1, i),
+                                                                        G(k * d + 2, i));
+      const double up = an + p.mu[k] * at, down = an - p.mu[k] * at;
+      const double c = p.cap_of(k);
+      hi += up > 0.0 ? c * up : 0.0;
+      lo += down < 0.0 ? c * down : 0.0;
+    }
+    const double tol = 1e-12 * std::max({std::abs(hi), std::abs(lo), std::abs(e[i])});
+    if (std::isfinite(hi) && e[i] > hi + tol)
+      return "no equilibrium: along rigid mode " + std::to_string(i) + " the load is "
+             + detail::exp3(e[i]) + " but the crushable contact forces can carry at most "
+             + detail::exp3(hi) + " (their caps): the surfaces would crush without end";
+    if (std::isfinite(lo) && e[i] < lo - tol)
+      return "no equilibrium: along rigid mode " + std::to_string(i) + " the load is "
+             + detail::exp3(e[i]) + " but the crushable contact forces can carry at least "
+             + detail::exp3(lo) + " (their caps): the surfaces would crush without end";
+  }
+  return "";
+}
+} // namespace
+
 SolveReport solve(const ProblemView& p, const Eigen::Ref<const Matrix>& G,
                   const Eigen::Ref<const Vector>& e, const Eigen::Ref<const Vector>& lambda0,
                   const Eigen::Ref<const Vector>& alpha0, const SolverOptions& opt)
@@ -288,6 +327,17 @@ SolveReport solve(const ProblemView& p, const Eigen::Ref<const Matrix>& G,
   const std::vector<std::string> chain = opt.chain.empty() ? default_chain() : opt.chain;
   std::vector<std::string> attempts;
   SolveReport best;
+  if (p.capped() && e.size() == G.cols())
+    if (std::string why = no_equilibrium(p, G, e); !why.empty())
+    {
+      best.solver = "none";
+      best.lambda = Vector::Zero(p.q.size());
+      best.u = p.q;
+      best.alpha = Vector::Zero(G.cols());
+      best.states.assign(static_cast<std::size_t>(p.pairs()), PairState::open);
+      best.attempts = {why};
+      return best;
+    }
   bool tried = false;
   for (const auto& name : chain)
   {

@@ -86,7 +86,7 @@ void ac_all(const ProblemView& p, const Vector& rho, const Vector& rho_t, const 
   const int d = p.dim;
   for (int k = 0; k < p.pairs(); ++k)
     ac_pair(lam.data() + k * d, u.data() + k * d, p.mu[k], rho[k], rho_t[k], d,
-            phi.data() + k * d, dP ? dP->data() + k * d * d : nullptr);
+            phi.data() + k * d, dP ? dP->data() + k * d * d : nullptr, p.cap_of(k));
 }
 
 double merit(const ProblemView& p, const Vector& rho, const Vector& rho_t, const Vector& lam,

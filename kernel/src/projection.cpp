@@ -11,6 +11,7 @@
 #include "ac_pair.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -26,7 +27,7 @@ double tnorm(const Vec3& v, int d) { return d == 2 ? std::abs(v[1]) : std::hypot
 
 /// @brief Local Alart–Curnier Newton for one pair, u = A λ + c; true if Φ vanished (to
 /// rounding) from the start λ. ρ = 1/A_nn.
-bool local_newton(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
+bool local_newton(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam, double cap)
 {
   const double rho = 1.0 / A(0, 0);
   const double at = d == 2 ? A(1, 1) : 0.5 * (A(1, 1) + A(2, 2));
@@ -39,7 +40,7 @@ bool local_newton(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
   auto eval = [&](const Vec3& l, Vec3& ph, double* dp)
   {
     const Vec3 u = A * l + c;
-    detail::ac_pair(l.data(), u.data(), mu, rho, rt, d, ph.data(), dp);
+    detail::ac_pair(l.data(), u.data(), mu, rho, rt, d, ph.data(), dp, cap);
   };
   eval(lam, phi, dPr);
   for (int it = 0; it < 50; ++it)
@@ -147,9 +148,59 @@ bool slip_by_angle(const Mat3& A, const Vec3& c, double mu, Vec3& lam)
   return std::isfinite(best);
 }
 
+/// @brief The crushing candidates of one pair, λ_n = cap and u_n ≤ 0 (problem.hpp): the
+/// tangential force with the normal one fixed, stick (u_t = 0) inside the disc, or in 2D
+/// slip on its rim against u_t. False if none of them holds; 3D slip is left to the caller.
+bool crushed_solve(const Mat3& A, const Vec3& c, double mu, int d, double cap, Vec3& lam)
+{
+  auto un = [&](const Vec3& l) { return A.row(0).dot(l) + c[0]; };
+  Vec3 l(cap, 0.0, 0.0);
+  if (mu == 0.0)
+  {
+    if (un(l) <= 0.0)
+    {
+      lam = l;
+      return true;
+    }
+    return false;
+  }
+  // Stick: A_tt λ_t = −(A_tn cap + c_t).
+  const Eigen::Vector2d bt(A(1, 0) * cap + c[1], A(2, 0) * cap + c[2]);
+  Eigen::Matrix2d Att = A.block<2, 2>(1, 1);
+  if (d == 2)
+    Att(1, 1) = A(1, 1) > 0.0 ? A(1, 1) : 1.0;
+  const Eigen::FullPivLU<Eigen::Matrix2d> lu(Att);
+  if (lu.isInvertible())
+  {
+    Eigen::Vector2d lt = lu.solve(-bt);
+    if (d == 2)
+      lt[1] = 0.0;
+    l = Vec3(cap, lt[0], lt[1]);
+    if (l.allFinite() && tnorm(l, d) <= mu * cap && un(l) <= 0.0)
+    {
+      lam = l;
+      return true;
+    }
+  }
+  if (d == 3)
+    return false;
+  for (double sg : {1.0, -1.0})
+  {
+    l = Vec3(cap, -mu * sg * cap, 0.0);
+    const double ut = A(1, 0) * l[0] + A(1, 1) * l[1] + c[1];
+    if (sg * ut >= 0.0 && un(l) <= 0.0)
+    {
+      lam = l;
+      return true;
+    }
+  }
+  return false;
+}
+
 /// @brief Exact solution of one pair's problem u = A λ + c (A the pair's diagonal block of W,
-/// c the rest of u). Returns false when the block is too degenerate for every case.
-bool local_solve(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
+/// c the rest of u), with the normal force capped at `cap` (+∞: no cap). Returns false when
+/// the block is too degenerate for every case.
+bool local_solve(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam, double cap)
 {
   // Open: with λ = 0 the pair does not penetrate.
   if (c[0] >= 0.0)
@@ -159,12 +210,14 @@ bool local_solve(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
   }
   const double ann = A(0, 0);
   if (!(ann > 0.0))
-    return false;
+    return cap < std::numeric_limits<double>::infinity() && crushed_solve(A, c, mu, d, cap, lam);
   if (mu == 0.0)
   {
-    // Frictionless: λ_t = 0, and the normal row alone closes the gap.
+    // Frictionless: λ_t = 0, and the normal row alone closes the gap (or crushes).
     lam.setZero();
     lam[0] = -c[0] / ann;
+    if (lam[0] > cap)
+      lam[0] = cap;
     return true;
   }
   // Stick: u = 0.
@@ -178,7 +231,7 @@ bool local_solve(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
     {
       Vec3 s = lu.solve(-c);
       s[2] = d == 2 ? 0.0 : s[2];
-      if (s.allFinite() && s[0] >= 0.0 && tnorm(s, d) <= mu * s[0])
+      if (s.allFinite() && s[0] >= 0.0 && tnorm(s, d) <= mu * s[0] && !(s[0] > cap))
       {
         lam = s;
         return true;
@@ -196,29 +249,38 @@ bool local_solve(const Mat3& A, const Vec3& c, double mu, int d, Vec3& lam)
       const double ln = -c[0] / den;
       const double lt = -mu * sg * ln;
       const double ut = A(1, 0) * ln + A(1, 1) * lt + c[1];
-      if (sg * ut >= 0.0)
+      if (sg * ut >= 0.0 && !(ln > cap))
       {
         lam = Vec3(ln, lt, 0.0);
         return true;
       }
     }
-    return false;
+    return cap < std::numeric_limits<double>::infinity() && crushed_solve(A, c, mu, d, cap, lam);
   }
+  if (cap < std::numeric_limits<double>::infinity() && crushed_solve(A, c, mu, d, cap, lam))
+    return true;
   // 3D slip: the direction is unknown; local Newton, warm then from the stick guess projected.
   Vec3 l0 = lam;
-  if (local_newton(A, c, mu, d, l0))
+  if (local_newton(A, c, mu, d, l0, cap))
   {
     lam = l0;
     return true;
   }
   l0.setZero();
-  l0[0] = -c[0] / ann;
-  if (local_newton(A, c, mu, d, l0))
+  l0[0] = std::min(-c[0] / ann, cap);
+  if (local_newton(A, c, mu, d, l0, cap))
   {
     lam = l0;
     return true;
   }
-  return slip_by_angle(A, c, mu, lam);
+  // The angle scan knows no cap: its answer counts only within it.
+  Vec3 ls = lam;
+  if (slip_by_angle(A, c, mu, ls) && !(ls[0] > cap))
+  {
+    lam = ls;
+    return true;
+  }
+  return false;
 }
 } // namespace
 
@@ -238,7 +300,7 @@ int detail::nsgs_sweep(const ProblemView& p, const Vector& rho, Vector& lam, Vec
     l.head(d) = lam.segment(o, d);
     c.head(d) = u.segment(o, d) - A.topLeftCorner(d, d) * l.head(d);
     Vec3 lnew = l;
-    if (!local_solve(A, c, p.mu[k], d, lnew))
+    if (!local_solve(A, c, p.mu[k], d, lnew, p.cap_of(k)))
     {
       // Degenerate block: the De Saxcé–Feng step with the problem's ρ.
       ++fallbacks;
@@ -246,7 +308,7 @@ int detail::nsgs_sweep(const ProblemView& p, const Vector& rho, Vector& lam, Vec
       uk.head(d) = u.segment(o, d);
       lnew = l - rho[k] * uk;
       lnew[0] = l[0] - rho[k] * (uk[0] + p.mu[k] * tnorm(uk, d));
-      project_on_cone(lnew.data(), d, p.mu[k]);
+      project_on_truncated_cone(lnew.data(), d, p.mu[k], p.cap_of(k));
     }
     delta = lnew - l;
     if (delta.squaredNorm() > 0.0)

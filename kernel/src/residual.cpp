@@ -55,6 +55,22 @@ void project_on_cone(double* r, int dim, double mu)
     r[i] *= s;
 }
 
+void project_on_truncated_cone(double* r, int dim, double mu, double cap)
+{
+  project_on_cone(r, dim, mu);
+  if (!(r[0] > cap))
+    return;
+  // Beyond the cap the nearest point is on the cap's disc, (cap, P_disc(μ·cap)(z_t)). The
+  // cone's answer has z's tangential direction and, when it left the cone, |z_t| > μ·cap
+  // (else z_n > cap would put z inside): the disc's projection of it is the same point.
+  const double rt = tangent_norm(r, dim);
+  const double limit = mu * cap;
+  r[0] = cap;
+  if (rt > limit)
+    for (int i = 1; i < dim; ++i)
+      r[i] *= limit / rt;
+}
+
 Vector pair_rho(const ProblemView& p)
 {
   check_view(p);
@@ -107,7 +123,7 @@ double natural_map_residual(const ProblemView& p, const Eigen::Ref<const Vector>
     z[0] = lambda[k * d] - rho[k] * unhat;
     for (int i = 1; i < d; ++i)
       z[i] = lambda[k * d + i] - rho[k] * uk[i];
-    project_on_cone(z, d, mu);
+    project_on_truncated_cone(z, d, mu, p.cap_of(k));
     for (int i = 0; i < d; ++i)
     {
       e[k * d + i] = lambda[k * d + i] - z[i];
@@ -147,6 +163,11 @@ std::vector<PairState> classify_states(const ProblemView& p,
     const double ln = lambda[k * d];
     if (!(ln > tol * lscale) || lscale == 0.0)
       continue; // open
+    if (ln >= (1.0 - tol) * p.cap_of(k))
+    {
+      s[k] = PairState::crush;
+      continue;
+    }
     const double ut = tangent_norm(u.data() + k * d, d);
     s[k] = (ut > tol * uscale) ? PairState::slip : PairState::stick;
   }

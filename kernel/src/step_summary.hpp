@@ -10,7 +10,8 @@ namespace flexcontact::detail
 {
 /// @brief An increment's totals from its λ and gap, shared by the dense and the operator
 /// condensed problems: slip (tangential gap − slip_origin), each pair's friction force in
-/// global axes, the normal and tangential resultants, the largest penetration and the
+/// global axes, the normal and tangential resultants, the largest penetration (of the
+/// crushed surface where r.crush_depth is set) and the
 /// contact forces r_c = Bᵀ λ (zero on held DOFs).
 inline void summarize_step(CondensedStep& r, const std::vector<ContactPair>& pairs, int d,
                            const Vector& slip_origin, const Eigen::SparseMatrix<double>& B,
@@ -24,7 +25,8 @@ inline void summarize_step(CondensedStep& r, const std::vector<ContactPair>& pai
   for (int k = 0; k < m; ++k)
   {
     r.normal_force += r.lambda[k * d];
-    min_gap = std::min(min_gap, r.gap[k * d]);
+    // A crushed surface is δ behind the elastic one: that much gap is not penetration.
+    min_gap = std::min(min_gap, r.gap[k * d] + (r.crush_depth.size() ? r.crush_depth[k] : 0.0));
     for (int j = 1; j < d; ++j)
     {
       r.slip[k * (d - 1) + j - 1] = r.gap[k * d + j] - slip_origin[k * d + j];

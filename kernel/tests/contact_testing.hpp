@@ -131,7 +131,8 @@ inline Matrix random_spd(int n, double cond, unsigned seed, double scale = 1.0,
   return 0.5 * (W + W.transpose());
 }
 
-/// @brief Empty if (λ, u = Wλ + q) satisfies Signorini and Coulomb to tol, in force units
+/// @brief Empty if (λ, u = Wλ + q) satisfies Signorini and Coulomb (with the normal force
+/// caps of p, where a pair at its cap may crush, u_n ≤ 0) to tol, in force units
 /// (ρ u with ρ = pair_rho), relative to S = max(‖λ‖, ‖ρ q‖); otherwise what fails, and where.
 inline std::string check_laws(const ProblemView& p, const Vector& lambda, double tol)
 {
@@ -152,12 +153,24 @@ inline std::string check_laws(const ProblemView& p, const Vector& lambda, double
     const Vector lt = lambda.segment(k * d + 1, d - 1);
     const double un = rho[k] * u[k * d];
     const Vector ut = rho[k] * u.segment(k * d + 1, d - 1);
+    const double cap = p.cap_of(k);
     if (ln < -tol * S)
       err << "pair " << k << ": lambda_n = " << ln << " < 0; ";
-    if (un < -tol * S)
-      err << "pair " << k << ": penetration rho*u_n = " << un << "; ";
-    if (std::abs(ln * un) > tol * S * std::max(S, std::abs(un)))
-      err << "pair " << k << ": complementarity lambda_n*rho*u_n = " << ln * un << "; ";
+    if (ln > cap + tol * S)
+      err << "pair " << k << ": lambda_n = " << ln << " above its cap " << cap << "; ";
+    if (ln >= cap - tol * S)
+    {
+      // At the cap the surface may crush (u_n ≤ 0) but not separate.
+      if (un > tol * S)
+        err << "pair " << k << ": at its cap and separating, rho*u_n = " << un << "; ";
+    }
+    else
+    {
+      if (un < -tol * S)
+        err << "pair " << k << ": penetration rho*u_n = " << un << "; ";
+      if (std::abs(ln * un) > tol * S * std::max(S, std::abs(un)))
+        err << "pair " << k << ": complementarity lambda_n*rho*u_n = " << ln * un << "; ";
+    }
     if (lt.norm() > mu * ln + tol * S)
       err << "pair " << k << ": outside cone |lambda_t| = " << lt.norm() << " > mu lambda_n = "
           << mu * ln << "; ";

@@ -16,7 +16,7 @@ from petsc4py import PETSc
 from . import _cpp, compat
 from .memory import check_dense_memory_collective
 from .mpi import raise_on_every_rank
-from .pairing import NodePairs
+from .pairing import NodePairs, pair_caps
 
 
 def kernel_pairs(pairs) -> list:
@@ -78,6 +78,9 @@ class Condensation:
             t0 = time.perf_counter()
             build = kernel if kernel is not None else _cpp.CondensedContact
             self.contact = build(dim, F, pairs.x, kernel_pairs(pairs), mu, constrained, options)
+            caps = pair_caps(pairs)
+            if caps is not None:
+                self.contact.set_crushing(caps)
             self.timings["delassus_s"] = time.perf_counter() - t0
 
     def _contact_scatter(self, K: PETSc.Mat, pairs, dim: int) -> None:
@@ -133,7 +136,8 @@ class Condensation:
         """New pairs on the same contact nodes (rank 0): B, x0, W rebuilt from the stored F*,
         no factorization."""
         self.pairs = pairs
-        self.contact.set_pairs(kernel_pairs(pairs), mu)
+        caps = pair_caps(pairs)
+        self.contact.set_pairs(kernel_pairs(pairs), mu, np.zeros(0) if caps is None else caps)
         self._cached = None
 
     def refactor(self, A: PETSc.Mat, method: str, ordering: str, dt_s: float,

@@ -43,7 +43,7 @@ from .energy import EnergyAccount
 from .names import check_chain, check_flexibility_method, check_ordering
 from .pairing import pair_interfaces
 from .postprocess import ContactFields
-from .states import OPEN, SLIP, STICK
+from .states import CRUSH, OPEN, SLIP, STICK
 from .stepper import Stepper, StepperViews
 from .errors import InputError
 
@@ -74,6 +74,11 @@ class ImpactStepRecord:
     solver: str
     iterations: int
     max_penetration_m: float
+    crush: int = 0               # pairs at their force cap (crushable interfaces)
+    crush_depth_max_m: float = 0.0  # deepest crush of a slave node so far
+    # Σ_k a_k δ_k: the crushed volume so far [m³; m² per unit thickness in 2D], a_k the
+    # measure each pair's force acts on
+    crushed_volume_m3: float = 0.0
     energy: dict = field(default_factory=dict)
     momentum: dict = field(default_factory=dict)  # body -> d components [N·s]
 
@@ -362,9 +367,10 @@ class ImpactProblem(StepperViews):
         numerical = self._numerical_dissipation(du, v_new)  # before Mv holds M v⁺
         self.M.mult(v_new, Mv)
         kinetic = 0.5 * v_new.dot(Mv)
-        works = (out["contact_work"], out["friction_work"]) if self.comm.rank == 0 else None
-        cw, fw = self.comm.bcast(works, root=0)
-        self.energy.add_step(kinetic, strain, external, damping, cw, fw, numerical)
+        works = ((out["contact_work"], out["friction_work"], out["crush_work"])
+                 if self.comm.rank == 0 else None)
+        cw, fw, crw = self.comm.bcast(works, root=0)
+        self.energy.add_step(kinetic, strain, external, damping, cw, fw, numerical, crw)
         self._last_momentum = self._momentum(Mv)
 
     def _numerical_dissipation(self, du: PETSc.Vec, v_new: PETSc.Vec) -> float:
@@ -392,7 +398,12 @@ class ImpactProblem(StepperViews):
                 slip=int(((s == SLIP) & closed).sum()), open=int((s == OPEN).sum()),
                 back_substitutions=solves, solver=str(rep["solver"]),
                 iterations=int(rep["iterations"]),
-                max_penetration_m=float(out["max_penetration"]))
+                max_penetration_m=float(out["max_penetration"]),
+                crush=int(((s == CRUSH) & closed).sum()),
+                crush_depth_max_m=float(np.max(out["crush_depth"], initial=0.0))
+                if "crush_depth" in out else 0.0,
+                crushed_volume_m3=float(np.dot(out["crush_depth"], self.pairs.tributary))
+                if "crush_depth" in out else 0.0)
         rec = self.comm.bcast(rec, root=0)
         rec.energy = self.energy.history[-1]
         rec.momentum = self._last_momentum

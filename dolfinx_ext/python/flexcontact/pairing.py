@@ -70,6 +70,13 @@ class NodePairs:
     def node_area(self) -> np.ndarray:
         return np.concatenate([self.area, self.area_master])
 
+    @property
+    def tributary(self) -> np.ndarray:
+        """The measure each pair's normal force acts on: the slave's tributary measure."""
+        return self.area
+
+    crushing_strength: Optional[np.ndarray] = None  # (m,) σ_c per pair [Pa], inf: none
+
     n_virtual = 0
 
 
@@ -165,7 +172,7 @@ def pair_interfaces(V, interfaces: Sequence, comm):
     msh = V.mesh
     compat.create_connectivity(msh, msh.topology.dim - 1, msh.topology.dim)
     root = comm.rank == 0
-    parts, mus, error, surfaces = [], [], None, []
+    parts, mus, sigmas, error, surfaces = [], [], [], None, []
     for itf in interfaces:
         rigid = not isinstance(itf.master, (int, np.integer))
         kind = "rigid" if rigid else getattr(itf, "pairing", "node_to_node")
@@ -178,6 +185,9 @@ def pair_interfaces(V, interfaces: Sequence, comm):
                 kind, other = _resolve(kind, s, m, itf, V.mesh.geometry.dim)
                 parts.append((kind, s, other))
                 mus.append(np.full(np.asarray(s["x"]).shape[0], float(itf.mu)))
+                sigma = getattr(itf, "crushing_strength_Pa", None)
+                sigmas.append(np.full(np.asarray(s["x"]).shape[0],
+                                      np.inf if sigma is None else float(sigma)))
             except ValueError as e:
                 error = str(e)
     if root and error is None and any(k != "node_to_node" for k, _, _ in parts):
@@ -196,8 +206,26 @@ def pair_interfaces(V, interfaces: Sequence, comm):
     for itf, kind in zip(interfaces, kinds):
         itf.pairing_used = kind   # what "auto" chose (and "rigid" for rigid targets)
     pairs = pairs if root else None
+    if root:
+        pairs.crushing_strength = np.concatenate(sigmas)
     mu = np.concatenate(mus) if root else np.zeros(0)
     return pairs, mu, comm.bcast(pairs.m if root else None, root=0)
+
+
+def pair_caps(pairs) -> Optional[np.ndarray]:
+    """The caps of the pairs' normal forces, σ_c × the measure each acts on [N; N/m in 2D]
+    (inf where the interface does not crush), or None when no interface crushes (rank 0).
+    A mortar row's measure is its D_jj of the current pairing, so its cap follows the
+    overlap, while the slave node's crush depth carries over (docs/crushing.md)."""
+    sigma = getattr(pairs, "crushing_strength", None)
+    if sigma is None or not np.isfinite(sigma).any():
+        return None
+    finite = np.isfinite(sigma)
+    caps = np.full(sigma.shape, np.inf)
+    caps[finite] = sigma[finite] * np.asarray(pairs.tributary, float)[finite]
+    # A slave node with no measure (nothing covered) gets no force at all: a tiny cap
+    # rather than zero, which the kernel refuses.
+    return np.where(caps > 0.0, caps, np.finfo(float).tiny)
 
 
 class SelfContactWarning(UserWarning):

@@ -15,7 +15,7 @@ from mpi4py import MPI
 import dolfinx.fem
 
 from . import compat
-from .states import OPEN, SLIP, STICK, STATE_NAMES  # noqa: F401  (STATE_NAMES: re-exported)
+from .states import CRUSH, OPEN, SLIP, STICK, STATE_NAMES  # noqa: F401  (STATE_NAMES: re-exported)
 from .writeback import set_nodal_values
 from .pairing import NodePairs
 from .errors import SolveError
@@ -45,13 +45,18 @@ class IncrementSummary:
     time_s: float
     zone_edge: list = field(default_factory=list)  # interfaces whose contact reached an
     #                                                open edge of a candidate surface
+    crush: int = 0                  # pairs at their force cap (crushable interfaces)
+    crush_depth_max_m: float = 0.0  # deepest crush of a slave node so far
+    crush_work: float = 0.0         # energy the crushing dissipated in the increment [J]
 
     def line(self) -> str:
         t = np.linalg.norm(self.tangential_force)
         return (f"increment {self.increment:3d}: N = {self.normal_force:11.4e}  "
                 f"|T| = {t:11.4e}  stick/slip/open = {self.stick}/{self.slip}/{self.open}  "
                 f"penetration = {self.max_penetration_rel:8.1e}  residual = {self.residual:8.1e}"
-                f"  {self.solver} ({self.iterations} it)")
+                f"  {self.solver} ({self.iterations} it)"
+                + (f"  crush = {self.crush} (deepest {self.crush_depth_max_m:.3e} m)"
+                   if self.crush_depth_max_m > 0 else ""))
 
 
 @dataclass
@@ -61,9 +66,10 @@ class IncrementResult:
     summary: IncrementSummary
     lam: np.ndarray        # (m, d) λ in the local frame (λ_n ≥ 0 compression) [N or N/m]
     gap: np.ndarray        # (m, d) total gap x in the local frame [m]
-    states: np.ndarray     # (m,) states.OPEN, STICK or SLIP
+    states: np.ndarray     # (m,) states.OPEN, STICK, SLIP or CRUSH
     slip_increment: np.ndarray  # (m, d-1) tangential slip in this increment [m]
     tangential: Optional[np.ndarray] = None  # (m, d) friction force per pair, global axes
+    crush_depth: Optional[np.ndarray] = None  # (m,) δ of each pair's slave node [m]
 
 
 def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
@@ -87,18 +93,20 @@ def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
             max_penetration_rel=pen / umax if umax > 0 else 0.0,
             residual=float(rep["residual"]), iterations=int(rep["iterations"]),
             state_changes=int(rep["state_changes"]), solver=str(rep["solver"]),
-            time_s=elapsed)
+            time_s=elapsed, crush=int((states == CRUSH).sum()),
+            crush_depth_max_m=float(np.max(out.get("crush_depth", np.zeros(0)), initial=0.0)),
+            crush_work=float(out.get("crush_work", 0.0)))
     summary = comm.bcast(summary, root=0)
     if root:
         return IncrementResult(summary, out["lambda"], out["gap"], states, out["slip"],
-                               out["pair_tangential"])
+                               out["pair_tangential"], out.get("crush_depth"))
     e = np.zeros((0, dim))
     return IncrementResult(summary, e, e, np.zeros(0, int), e[:, 1:], e)
 
 
 def _nodal_contact(inc: IncrementResult, pairs):
-    """Pressure, tangential traction (global axes) and status (states.py: OPEN, STICK, SLIP) at
-    every contact node: a slave node carries its pair's force over its tributary measure,
+    """Pressure, tangential traction (global axes) and status (states.py: OPEN, STICK, SLIP,
+    CRUSH) at every contact node: a slave node carries its pair's force over its tributary measure,
     a master node the equal and opposite forces Σ_k w_kj (…) of the pairs that use it."""
     m, n = pairs.m, pairs.x.shape[0]
     masters, weights = pairs.masters, pairs.weights
@@ -120,7 +128,7 @@ def _nodal_contact(inc: IncrementResult, pairs):
 
 class ContactFields:
     """The output Functions: displacement, contact pressure, tangential traction, status
-    (1 open, 2 stick, 3 slip) and, if ``stress`` is given (u -> UFL scalar), a DG0 stress."""
+    (1 open, 2 stick, 3 slip, 4 crush) and, if ``stress`` is given (u -> UFL scalar), a DG0 stress."""
 
     def __init__(self, V, comm, stress: Optional[Callable] = None):
         msh = V.mesh

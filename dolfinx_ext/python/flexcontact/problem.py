@@ -94,6 +94,14 @@ class ContactInterface:
     (ContactZoneError after the increment is recorded) or "ignore"; the increment summary
     lists the interface in ``zone_edge`` either way.
 
+    ``crushing_strength_Pa`` (σ_c, default None: no crushing) makes the slave surface
+    crushable (docs/crushing.md): each pair's normal force is capped at σ_c times the
+    measure it acts on (a mortar row's D_jj, else the slave node's tributary length or
+    area), a cap on the nodal-average pressure. Where the cap binds, the slave surface
+    crushes irreversibly along the pair normal; each slave node keeps its crush depth
+    across increments, time steps and re-pairing, and friction is bounded by μ times the
+    capped force.
+
     A master surface on the slave's own body (the mesh connects their nodes) is refused with
     an error naming both tags, as it is almost always a boundary tag given as the master;
     ``self_contact=True`` says a body touching itself is meant (a SelfContactWarning then).
@@ -108,9 +116,13 @@ class ContactInterface:
     pairing: Pairing = "auto"
     zone_edge: ZoneEdgeAction = "warn"
     self_contact: bool = False
+    crushing_strength_Pa: Optional[float] = None
 
     def __post_init__(self):
         self.mu = _friction_coefficient(self.mu, self.label)
+        if self.crushing_strength_Pa is not None:
+            self.crushing_strength_Pa = _crushing_strength(self.crushing_strength_Pa,
+                                                           self.label)
         where = f"contact interface {self.label}"
         check_option(self.pairing, PAIRINGS, "pairing", where)
         check_option(self.zone_edge, ZONE_EDGE_ACTIONS, "zone_edge", where)
@@ -135,6 +147,21 @@ class ContactInterface:
     @property
     def rigid(self) -> bool:
         return isinstance(self.master, RigidTarget)
+
+
+def _crushing_strength(sigma, label: str) -> float:
+    """σ_c as a float: a real number, finite and > 0."""
+    value = None
+    if not isinstance(sigma, (bool, np.bool_)):
+        arr = (np.asarray(sigma) if isinstance(sigma, (int, float, np.number, np.ndarray))
+               else None)
+        if arr is not None and arr.ndim == 0 and np.issubdtype(arr.dtype, np.number) \
+                and not np.issubdtype(arr.dtype, np.complexfloating):
+            value = float(arr)
+    if value is None or not math.isfinite(value) or value <= 0:
+        raise InputError(f"contact interface {label}: crushing_strength_Pa={sigma!r}; it must "
+                         "be a finite real number > 0 [Pa] (None: the surface does not crush)")
+    return value
 
 
 def _friction_coefficient(mu, label: str) -> float:
@@ -234,6 +261,11 @@ class ContactProblem(StepperViews):
         self.timings = {}
         self.increments: list[IncrementResult] = []
 
+        crushing = [i.label for i in self.interfaces if i.crushing_strength_Pa is not None]
+        if contact_operator == "factor" and crushing:
+            raise InputError(f"contact interface {crushing[0]}: crushing_strength_Pa is not "
+                             "available with contact_operator='factor' (its working-set "
+                             "solve has no cap on the normal force); use the dense operator")
         t0 = time.perf_counter()
         self.K = assemble_stiffness(self.a_form, self.bcs)
         self.timings["assemble_K_s"] = time.perf_counter() - t0

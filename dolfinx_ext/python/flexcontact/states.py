@@ -7,7 +7,8 @@ The kernel's pairs, the step results (``states`` arrays), the recorded problems
 * OPEN (1): no contact, λ = 0;
 * STICK (2): closed, no slip in the increment;
 * SLIP (3): closed, sliding on the Coulomb cone;
-* CRUSH (4): reserved for the crushing law.
+* CRUSH (4): closed at the normal force's cap of a crushable interface: the surface
+  crushes (docs/crushing.md).
 """
 from __future__ import annotations
 

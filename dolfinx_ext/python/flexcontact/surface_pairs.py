@@ -54,6 +54,10 @@ class SurfacePairs:
     interface: np.ndarray
     pairers: list = field(default_factory=list)
     targets: list = field(default_factory=list)   # RigidTarget per reference node
+    # (m,) the measure each pair's normal force acts on: a mortar row's D_jj (it changes
+    # with the overlap on re-pairing), else the slave node's tributary measure ``area``
+    tributary: Optional[np.ndarray] = None
+    crushing_strength: Optional[np.ndarray] = None  # (m,) σ_c per pair [Pa], inf: none
 
     @property
     def m(self) -> int:
@@ -91,6 +95,11 @@ class SurfacePairs:
             self.masters[rows] = np.hstack([masters, np.repeat(masters[:, :1], pad, axis=1)])
             self.weights[rows] = np.hstack([weights, np.zeros((rows.size, pad))])
             self.normal[rows], self.offset[rows], self.at_edge[rows] = normal, offset, edge
+            if self.tributary is None:
+                self.tributary = np.asarray(self.area, float).copy()
+            measure = getattr(p, "tributary", None)
+            if measure is not None:
+                self.tributary[rows] = measure
 
 
 @dataclass
@@ -157,6 +166,7 @@ class SurfaceToSurfacePairer:
     cutoff_m: float             # largest slave–master distance of an overlap
     width: int = 4
     covered: int = 0            # slave nodes with mortar rows at the last pairing
+    tributary: Optional[np.ndarray] = None  # D_jj of the last pairing (∫N_j uncovered)
 
     def pair(self, xcur):
         fb = self.fallback
@@ -199,6 +209,8 @@ class SurfaceToSurfacePairer:
         fs = facet_normals(Xs, local_s, self.slave_normal)
         ns = nodal_normals(Xs, local_s, fs)
         normal[rows_c] = -ns[rows_c]
+        # The cap of a crushable interface acts on the row's own measure (docs/crushing.md).
+        self.tributary = np.where(covered, D, full)
         partial = covered & (D < (1 - 1e-9) * full)
         on_master_edge = partial & np.any(fb.master_edge[m_out] & (w_out != 0), axis=1)
         edge = np.where(covered, self.fallback.slave_edge | on_master_edge, edge)

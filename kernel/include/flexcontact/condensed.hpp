@@ -36,6 +36,8 @@ struct CondensedStep
   Vector tangential_force;        ///< d, Σ_k T_kᵀ (0, λ_t,k): the total friction force
   double max_penetration = 0.0;   ///< max(0, −min_k x_n,k)
   Matrix pair_tangential;         ///< m × d, T_kᵀ (0, λ_t,k) per pair
+  Vector crush_depth;             ///< m crush depths δ after the increment (empty: no cap)
+  double crush_work = 0.0;        ///< Σ_k λ_n,k Δδ_k: energy the crushing dissipated
   Vector alpha;                   ///< k rigid-mode amplitudes (bodies held only by contact)
   Matrix undetermined;            ///< k × r directions of α no contact resists (α = 0 there)
 };
@@ -103,8 +105,19 @@ public:
   /// node that had a pair before keeps its λ (the same force in global axes, expressed in
   /// the new frame) and state as the warm start of the next increment; a new slave node
   /// starts open with λ = 0.
+  /// A crushable interface gives the new pairs' caps in `cap` (set_crushing); the crush
+  /// depth is the slave node's and carries over.
   /// @throws std::invalid_argument as the constructor
-  void set_pairs(std::vector<ContactPair> pairs, Vector mu);
+  void set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap = Vector());
+
+  /// @brief Caps c_k > 0 of the pairs' normal forces [N; N/m in 2D] (+∞: none; empty: no
+  /// crushing), kept until the next set_pairs. The crush depth δ of each slave node starts
+  /// at zero and is carried by the node across re-pairing (docs/crushing.md).
+  /// @throws std::invalid_argument on a wrong size or a cap ≤ 0 or NaN
+  void set_crushing(Vector cap);
+
+  /// @brief δ of every contact node [m] (zero where it is no pair's slave or never crushed).
+  const Vector& node_crush_depth() const { return crush_node_; }
 
   /// @brief q' = q with the last increment's tangential gap removed, as
   /// IncrementalSolver::local_q: the local problem the next step(up_c) solves for this q.
@@ -141,5 +154,7 @@ private:
   Vector q_;          ///< q of the last step() call
   Vector u_c_;        ///< contact displacement of the last increment, u_p,c + F* r_c + R_c α
   Matrix R_;          ///< rigid modes at the contact DOFs, n_c × k
+  Vector cap_;        ///< per pair, empty: no crushing
+  Vector crush_node_; ///< δ per contact node, the slave's material depth
 };
 } // namespace flexcontact

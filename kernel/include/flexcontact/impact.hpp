@@ -48,7 +48,12 @@ struct ImpactStep
   double friction_work = 0.0;
   /// Σ_k P_k·U_k^θ: the work of all contact impulses in the scheme's energy balance
   double contact_work = 0.0;
-  double max_penetration = 0.0;   ///< max(0, −min_k g_n,k) at the start of the step
+  /// Σ_k P_n,k max(0, −U_n,k^θ) over the crushing pairs: the part of contact_work the
+  /// crushing dissipated (≥ 0; minus it is in contact_work), h·cap·Δδ summed
+  double crush_work = 0.0;
+  Vector crush_depth;             ///< m, δ of each pair's slave after the step (empty: no cap)
+  /// max(0, −min_k (g_n,k + δ_k)) at the start of the step: the crushed surface's overlap
+  double max_penetration = 0.0;
   int active_pairs = 0;           ///< |I|
   /// n_c, Δv_c = v⁺_c − v⁻_c = F̂ (b̃_c + r_c) on the contact DOFs (step_condensed only,
   /// empty after step): the contact values from which the factor's expansion of the
@@ -109,7 +114,21 @@ public:
   /// W_eff rebuilt from the stored F̂, no factorization. Pair k keeps its last impulse and
   /// state as the next step's warm start (pair k is slave node k's before and after).
   /// @throws std::invalid_argument on bad pairs or mu; the object is then unchanged
-  void set_pairs(std::vector<ContactPair> pairs, Vector mu);
+  /// A crushable interface gives the new pairs' force caps in `cap` (set_crushing); the
+  /// crush depth is the slave node's and carries over.
+  void set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap = Vector());
+
+  /// @brief Caps c_k > 0 of the pairs' normal contact forces [N; N/m in 2D] (+∞: none;
+  /// empty: no crushing), kept until the next set_pairs. The impulse of a step is capped
+  /// at c_k h. Where the cap binds the pair's surface crushes: its slave node's crush depth
+  /// δ (zero at first, carried across re-pairing) grows by h·max(0, −U_n^θ), and the gap
+  /// of the index set and of the next steps is g_n + δ (docs/crushing.md).
+  /// @throws std::invalid_argument on a wrong size or a cap ≤ 0 or NaN
+  void set_crushing(Vector cap);
+
+  /// @brief δ of every contact node [m].
+  const Vector& node_crush_depth() const { return crush_node_; }
+  const Vector& cap() const { return cap_; } ///< per pair (empty: no crushing)
 
   /// @brief New time-step size: F̂ of the new Ŵ, W_eff rebuilt; pairs kept.
   /// @throws std::invalid_argument on a wrong size, non-finite entries or dt_s ≤ 0
@@ -133,6 +152,10 @@ private:
   void solve_active(ImpactStep& r, const Vector& Ufree);
   /// @brief Reaction, totals and the energy terms of a solved step.
   void finish(ImpactStep& r) const;
+  /// @brief Crush depths and crushing work of a solved step (pairs at their cap).
+  void crush(ImpactStep& r);
+  /// @brief δ of pair k's slave node (0 without crushing).
+  double crush_of(int k) const;
 
   int dim_;
   Matrix F_;
@@ -145,6 +168,8 @@ private:
   Eigen::SparseMatrix<double> B_;
   Vector x0_;
   Matrix W_;
+  Vector cap_;                     ///< force caps per pair, empty: no crushing
+  Vector crush_node_;              ///< crush depth δ per contact node [m]
   Vector last_P_;                  ///< warm start
   std::vector<PairState> last_states_;
 };

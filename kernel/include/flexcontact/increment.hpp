@@ -52,13 +52,27 @@ public:
   /// @throws std::invalid_argument on wrong sizes or non-finite λ
   void set_warm_start(Vector lambda, std::vector<PairState> states);
 
+  /// @brief A crushable interface (problem.hpp, docs/crushing.md): the cap c_k > 0 of each
+  /// pair's normal force (+∞: none) and its crush depth δ_k ≥ 0 so far [m], the depth by
+  /// which the pair's surface has crushed along its normal. The local problem's normal gap
+  /// is x_n + δ; a pair that ends an increment at its cap deepens δ to −x_n. Empty vectors
+  /// remove the cap (δ is then not used).
+  /// @throws std::invalid_argument on wrong sizes, a cap ≤ 0 or NaN, a δ < 0 or not finite
+  void set_crushing(Vector cap, Vector crush_depth);
+
   /// @brief q' of the local problem u = W λ + q' that step(q_total) solves next: q_total
-  /// with the last increment's tangential gap removed (sizes as for step()).
+  /// with the last increment's tangential gap removed and the crush depths added to the
+  /// normal gaps (sizes as for step()).
   Vector local_q(const Eigen::Ref<const Vector>& q_total) const;
 
   const Vector& gap() const { return x_; }          ///< total gap x of the last increment
   const Vector& force() const { return lambda_; }   ///< λ of the last increment
   const Vector& alpha() const { return alpha_; }    ///< rigid-mode amplitudes (bordered)
+  const Vector& cap() const { return cap_; }        ///< normal force caps (empty: none)
+  const Vector& crush_depth() const { return crush_; } ///< δ per pair after the last increment
+  /// Σ_k c_k (δ_k − δ_k,prev): the work the crushing forces did in the last increment [J,
+  /// J/m in 2D], the energy it dissipated
+  double crush_work() const { return crush_work_; }
   const Matrix& border() const { return G_; }       ///< G, m·d × k (k = 0: none)
   const std::vector<PairState>& states() const { return states_; }
   const SolveReport& last() const { return last_; }
@@ -74,6 +88,8 @@ private:
   Vector x_, lambda_;
   Matrix G_;
   Vector alpha_;
+  Vector cap_, crush_;
+  double crush_work_ = 0.0;
   std::vector<PairState> states_;
   SolveReport last_;
 };

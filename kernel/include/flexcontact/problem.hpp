@@ -15,6 +15,15 @@
 ///
 /// where u_t is the tangential slip of the increment. The incremental driver (increment.hpp)
 /// builds q from the total gap so that this holds.
+///
+/// A crushable interface caps each pair's normal force, λ_n ≤ c_k (docs/crushing.md):
+///
+///     λ_n = 0 ⇒ u_n ≥ 0,   0 < λ_n < c_k ⇒ u_n = 0,   λ_n = c_k ⇒ u_n ≤ 0   (crush),
+///     |λ_t| ≤ μ λ_n, Coulomb as above,
+///
+/// i.e. λ lies in the Coulomb cone truncated at λ_n = c_k, and −û (the De Saxcé velocity) is
+/// in that set's normal cone. A crushing pair's u_n < 0 is the surface's irreversible
+/// crush in the increment; the drivers carry it as a crush depth added to the gap.
 
 #include <Eigen/Dense>
 #include <limits>
@@ -35,7 +44,7 @@ enum class PairState : int
   open = 1,  ///< no contact: λ = 0
   stick = 2, ///< closed, no slip in the increment
   slip = 3,  ///< closed, sliding: λ_t on the boundary of the Coulomb cone
-  crush = 4  ///< reserved for the crushing law (normal force at its cap)
+  crush = 4  ///< closed at the cap of a crushable interface: λ_n = c_k, the surface crushes
 };
 
 /// @brief Read-only view of one local problem u = W λ + q with friction coefficients μ.
@@ -45,7 +54,21 @@ struct ProblemView
   Eigen::Ref<const Matrix> W;        ///< (m·d)×(m·d), symmetric positive semi-definite
   Eigen::Ref<const Vector> q;        ///< m·d
   Eigen::Ref<const Vector> mu;       ///< m, each ≥ 0
+  /// m caps c_k > 0 of the normal forces (+∞: none), or null for no cap at all. A cap of
+  /// +∞ and a null pointer give bitwise the same arithmetic.
+  const double* cap = nullptr;
   int pairs() const { return static_cast<int>(q.size()) / dim; }
+  /// @brief Pair k's cap, +∞ when it has none.
+  double cap_of(int k) const { return cap ? cap[k] : std::numeric_limits<double>::infinity(); }
+  /// @brief True if some pair has a finite cap.
+  bool capped() const
+  {
+    if (cap)
+      for (int k = 0; k < pairs(); ++k)
+        if (cap[k] < std::numeric_limits<double>::infinity())
+          return true;
+    return false;
+  }
 };
 
 /// @brief Options shared by every local solver.

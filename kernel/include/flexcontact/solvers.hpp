@@ -19,7 +19,10 @@ namespace flexcontact
 /// open (the seed opens it at once, which cycles on strongly coupled pairs); slip → stick
 /// when the slip reverses, slip → open on λ_n < 0, open → stick on u_n < 0. 3D directions
 /// use the projection weighting μλ_n s + ρ u_t (relaxed when they oscillate).
-/// Cycle detection: a revisited state vector stops it with cycled=true.
+/// Cycle detection: a revisited state vector stops it with cycled=true. With capped normal
+/// forces (problem.hpp) a fourth state, crush: λ_n at the cap, sticking or sliding
+/// tangentially; a closed pair passing its cap crushes, a crushing pair whose gap opens
+/// unloads (docs/crushing.md).
 /// @param states0 starting states per pair (empty: all stick)
 SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
                              const std::vector<PairState>& states0, const SolverOptions& opt);
