@@ -32,7 +32,7 @@ SIGMA_C = 30e6           # [Pa]
 STEEL = forms.Material(E_Pa=200e9, nu=0.0, name="steel")
 
 
-def _patch(dim, pairing, matching, pressure=False):
+def _patch(dim, pairing, matching, pressure=False, contact_operator="dense"):
     """The patch-test bodies, one material, ν = 0, frictionless and crushable; the top
     pushed down by a prescribed displacement, or loaded by a pressure (upper body then held
     only by contact). Returns (problem, load setter, geometry)."""
@@ -61,19 +61,24 @@ def _patch(dim, pairing, matching, pressure=False):
             p.value = value
         return problem, load, geo
     top, (top_v,) = fc.dirichlet(V, facets, tags.LOADED, components=[vert])
-    problem = fc.ContactProblem(a, None, bcs + top, itf, bodies=bodies)
+    problem = fc.ContactProblem(a, None, bcs + top, itf, bodies=bodies,
+                                contact_operator=contact_operator)
 
     def load(value):
         top_v.value = -value
     return problem, load, geo
 
 
-@pytest.mark.parametrize("dim, pairing, matching", [(2, "node_to_node", True),
-                                                    (3, "node_to_node", True),
-                                                    (2, "surface_to_surface", False),
-                                                    (3, "surface_to_surface", False)])
-def test_block_pressed_past_yield_crushes_uniformly(dim, pairing, matching):
-    problem, push, geo = _patch(dim, pairing, matching)
+@pytest.mark.parametrize("dim, pairing, matching, operator",
+                         [(2, "node_to_node", True, "dense"),
+                          (3, "node_to_node", True, "dense"),
+                          (2, "surface_to_surface", False, "dense"),
+                          (3, "surface_to_surface", False, "dense"),
+                          (2, "node_to_node", True, "factor"),
+                          (3, "surface_to_surface", False, "factor")])
+def test_block_pressed_past_yield_crushes_uniformly(dim, pairing, matching, operator):
+    """The dense operator and the factor path (working set of W's columns) alike."""
+    problem, push, geo = _patch(dim, pairing, matching, contact_operator=operator)
     yield_m = SIGMA_C * (geo["lower_height"] + geo["upper_height"]) / STEEL.E_Pa
     force_c = SIGMA_C * geo["area"]
     depth = 0.0
@@ -115,20 +120,6 @@ def test_bad_crushing_strength_is_named(value, words):
     with pytest.raises(InputError, match=f"crushing_strength_Pa=.*{words}"):
         fc.ContactInterface(None, slave=1, master=2, mu=0.0, name="log end",
                             crushing_strength_Pa=value)
-
-
-def test_factor_path_refuses_crushing_by_name():
-    msh, cells, facets, geo = patch.build(MPI.COMM_WORLD, dim=2, h_lower=0.02, h_upper=0.03)
-    V = compat.vector_space(msh)
-    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    dx = ufl.Measure("dx", domain=msh, subdomain_data=cells)
-    a = forms.elasticity_form(u, v, {tags.BASE: STEEL, tags.UPPER: STEEL}, dx, "plane_strain")
-    bcs, _ = fc.dirichlet(V, facets, tags.FIXED)
-    itf = fc.ContactInterface(facets, slave=tags.SLAVE, master=tags.MASTER, mu=0.0,
-                              name="crushable", crushing_strength_Pa=SIGMA_C)
-    with pytest.raises(InputError, match="crushable: crushing_strength_Pa is not available "
-                                         "with contact_operator='factor'"):
-        fc.ContactProblem(a, None, bcs, itf, contact_operator="factor")
 
 
 # ---- the bar with a crushable end -------------------------------------------------------

@@ -136,9 +136,10 @@ def test_default_log_stays_small_and_numbers_have_their_references(response):
 
 
 def test_a_fast_log_leaves_the_small_strain_range_with_a_warning():
-    """At 40 m/s the log's end is compressed to about v/c = 40/3800 ≈ 1 % on average and
-    more under its corner: the watch warns, naming the log and the strain."""
-    s = DamScenario(log_speed_m_s=40.0, log_gap_m=0.01)
+    """At 40 m/s an elastic log's end is compressed to about v/c = 40/3800 ≈ 1 % on average
+    and more under its corner: the watch warns, naming the log and the strain. (A crushing
+    end stays near σ_c/E = 0.26 %: the crush takes the rest.)"""
+    s = DamScenario(log_speed_m_s=40.0, log_gap_m=0.01, log_end_crushes=False)
     stage1 = solve_stage1(s, comm=COMM)
     c = math.sqrt(s.wood.E_Pa / (s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient)))
     assert s.log_speed_m_s / c > STRAIN_LIMIT

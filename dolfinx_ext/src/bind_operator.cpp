@@ -96,12 +96,22 @@ void flexcontact::bind_operator(py::module& m)
           "CondensedContact.step. Raises ConvergenceError (history unchanged). Collective.")
       .def(
           "set_pairs",
-          [](FactorContact& c, std::vector<ContactPair> pairs, Vector mu)
+          [](FactorContact& c, std::vector<ContactPair> pairs, Vector mu, Vector cap)
           {
             py::gil_scoped_release release;
-            c.contact->set_pairs(std::move(pairs), std::move(mu));
+            c.contact->set_pairs(std::move(pairs), std::move(mu), std::move(cap));
           },
-          py::arg("pairs"), py::arg("mu"), "New pairs: B, x0 and the scales rebuilt. Collective.")
+          py::arg("pairs"), py::arg("mu"), py::arg("cap") = Vector(),
+          "New pairs: B, x0 and the scales rebuilt; cap: the new pairs' normal force caps of "
+          "a crushable interface (empty: none). Collective.")
+      .def(
+          "set_crushing", [](FactorContact& c, Vector cap) { c.contact->set_crushing(cap); },
+          py::arg("cap"),
+          "Caps of the pairs' normal forces [N; N/m in 2D] (inf: none, empty: no crushing). "
+          "Collective: every rank's object takes the same caps.")
+      .def_property_readonly(
+          "node_crush_depth", [](const FactorContact& c) { return c.contact->node_crush_depth(); },
+          "Crush depth of every contact node [m]")
       .def(
           "apply_W",
           [](FactorContact& c, const Vector& x)

@@ -32,7 +32,20 @@ OperatorContact::OperatorContact(int dim, LinearOperator flexibility, Matrix X,
   detail::check_coordinates(X_, dim_, who);
   check_constrained(constrained_, contact_dofs(), who);
   detail::check_iteration_options(options_, who);
+  crush_node_ = Vector::Zero(X_.rows());
   set_pairs(std::move(pairs), std::move(mu));
+}
+
+void OperatorContact::set_crushing(Vector cap)
+{
+  if (cap.size() != 0 && cap.size() != pairs())
+    throw std::invalid_argument(who + "set_crushing: cap has " + std::to_string(cap.size())
+                                + " entries for " + std::to_string(pairs()) + " pairs");
+  for (Eigen::Index k = 0; k < cap.size(); ++k)
+    if (!(cap[k] > 0.0))
+      throw std::invalid_argument(who + "the cap of pair " + std::to_string(k) + " is "
+                                  + detail::num(cap[k]) + "; it must be > 0 (+inf: no cap)");
+  cap_ = std::move(cap);
 }
 
 Vector OperatorContact::flex(Vector r) const
@@ -57,10 +70,17 @@ Vector OperatorContact::apply_W(const Vector& x) const
   return B_ * flex(B_.transpose() * x);
 }
 
-void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
+void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
 {
   detail::check_mu_count(mu, pairs.size(), who);
   detail::check_friction(mu, who);
+  if (cap.size() != 0 && cap.size() != static_cast<Eigen::Index>(pairs.size()))
+    throw std::invalid_argument(who + "set_pairs: cap has " + std::to_string(cap.size())
+                                + " entries for " + std::to_string(pairs.size()) + " pairs");
+  for (Eigen::Index k = 0; k < cap.size(); ++k)
+    if (!(cap[k] > 0.0))
+      throw std::invalid_argument(who + "the cap of pair " + std::to_string(k) + " is "
+                                  + detail::num(cap[k]) + "; it must be > 0 (+inf: no cap)");
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
   // Slip of the next increment is measured from the new pairs' gap where the bodies are.
@@ -75,6 +95,7 @@ void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu)
   states_ = std::move(states);
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
+  cap_ = std::move(cap);
   // Both depend on B: the scales are estimated again when solve_operator next runs.
   scales_ = OperatorScales{};
   columns_ = PairColumns{};
@@ -169,7 +190,7 @@ SolveReport OperatorContact::solve_local(const Vector& q)
   {
     ws = solve_working_set(dim_, columns_,
                            [this](const std::vector<int>& p) { return fetch_columns(p); }, q,
-                           mu_, lambda_, states_, options_, same_);
+                           mu_, lambda_, states_, options_, same_, cap_);
     if (ws.converged)
       return ws;
   }
@@ -177,7 +198,7 @@ SolveReport OperatorContact::solve_local(const Vector& q)
   if (scales_.applications == 0 && !pairs_.empty())
     scales_ = operator_scales(W, dim_, pairs());
   const Vector start = ws.lambda.size() == q.size() ? ws.lambda : lambda_;
-  SolveReport r = solve_operator(dim_, W, scales_, q, mu_, start, options_);
+  SolveReport r = solve_operator(dim_, W, scales_, q, mu_, start, options_, cap_);
   r.attempts.insert(r.attempts.begin(), ws.attempts.begin(), ws.attempts.end());
   return r;
 }
@@ -193,6 +214,9 @@ CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
   for (int k = 0; k < m; ++k)
     for (int j = 1; j < d; ++j)
       r.local_q[k * d + j] -= x_[k * d + j];
+  // The crushed surface is δ behind the elastic one (docs/crushing.md).
+  for (int k = 0; k < m && cap_.size(); ++k)
+    r.local_q[k * d] += crush_of(k);
   const long before = applications_, columns_before = block_columns_;
   r.report = solve_local(r.local_q);
   r.report.attempts.back() += ", " + std::to_string(applications_ - before) + " F* products, "
@@ -211,6 +235,24 @@ CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
     for (int j = 1; j < d; ++j)
       r.gap[k * d + j] += x_[k * d + j];
   r.states = r.report.states;
+  if (cap_.size())
+  {
+    // The elastic gap; a pair at its cap deepens its slave node's crush to −x_n.
+    r.crush_depth.resize(m);
+    for (int k = 0; k < m; ++k)
+    {
+      const double before_k = crush_of(k);
+      r.gap[k * d] -= before_k;
+      double depth = before_k;
+      if (r.states[k] == PairState::crush && -r.gap[k * d] > before_k)
+      {
+        depth = -r.gap[k * d];
+        r.crush_work += r.lambda[k * d] * (depth - before_k);
+      }
+      crush_node_[pairs_[static_cast<std::size_t>(k)].slave] = depth;
+      r.crush_depth[k] = depth;
+    }
+  }
   detail::summarize_step(r, pairs_, d, x_, B_, constrained_);
   r.alpha = Vector::Zero(0);
   r.undetermined = Matrix::Zero(0, 0);
@@ -220,5 +262,10 @@ CondensedStep OperatorContact::step(const Eigen::Ref<const Vector>& up_c)
   up_c_ = up_c;
   reaction_ = r.reaction;
   return r;
+}
+
+double OperatorContact::crush_of(int k) const
+{
+  return crush_node_[pairs_[static_cast<std::size_t>(k)].slave];
 }
 } // namespace flexcontact

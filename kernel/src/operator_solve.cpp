@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -24,10 +25,11 @@ double tangent_norm(const double* r, int dim)
   return dim == 2 ? std::abs(r[1]) : std::hypot(r[1], r[2]);
 }
 
-void project_all(Vector& lambda, int dim, const Eigen::Ref<const Vector>& mu)
+void project_all(Vector& lambda, int dim, const Eigen::Ref<const Vector>& mu, const Vector& cap)
 {
   for (Eigen::Index k = 0; k < mu.size(); ++k)
-    project_on_cone(lambda.data() + k * dim, dim, mu[k]);
+    project_on_truncated_cone(lambda.data() + k * dim, dim, mu[k],
+                              cap.size() ? cap[k] : std::numeric_limits<double>::infinity());
 }
 
 /// @brief The De Saxcé modified velocity û = (u_n + μ|u_t|, u_t): its fixed point
@@ -42,7 +44,8 @@ Vector de_saxce(const Vector& u, int dim, const Eigen::Ref<const Vector>& mu)
 
 /// @brief States read from (λ, u) as classify_states (residual.hpp) does, without W.
 std::vector<PairState> states_of(const Vector& lambda, const Vector& u,
-                                 const Eigen::Ref<const Vector>& q, int dim, double tol = 1e-8)
+                                 const Eigen::Ref<const Vector>& q, int dim, const Vector& cap,
+                                 double tol = 1e-8)
 {
   const Eigen::Index m = q.size() / dim;
   const double lscale = lambda.size() ? lambda.cwiseAbs().maxCoeff() : 0.0;
@@ -53,6 +56,11 @@ std::vector<PairState> states_of(const Vector& lambda, const Vector& u,
   {
     if (!(lambda[k * dim] > tol * lscale) || lscale == 0.0)
       continue;
+    if (cap.size() && lambda[k * dim] >= (1.0 - tol) * cap[k])
+    {
+      s[static_cast<std::size_t>(k)] = PairState::crush;
+      continue;
+    }
     const double ut = tangent_norm(u.data() + k * dim, dim);
     s[static_cast<std::size_t>(k)] = ut > tol * uscale ? PairState::slip : PairState::stick;
   }
@@ -102,15 +110,22 @@ std::vector<int> initial_set(const Eigen::Ref<const Vector>& q, const Vector& la
 struct Restricted
 {
   Matrix W;
-  Vector q, mu, lambda;
+  Vector q, mu, lambda, cap;
   std::vector<PairState> states;
 };
 
 Restricted restrict_to(const PairColumns& c, const std::vector<int>& A, int d,
                        const Eigen::Ref<const Vector>& q, const Eigen::Ref<const Vector>& mu,
-                       const Vector& lam, const std::vector<PairState>& states0)
+                       const Vector& lam, const std::vector<PairState>& states0,
+                       const Vector& cap)
 {
   Restricted r;
+  if (cap.size())
+  {
+    r.cap.resize(static_cast<Eigen::Index>(A.size()));
+    for (std::size_t a = 0; a < A.size(); ++a)
+      r.cap[static_cast<Eigen::Index>(a)] = cap[A[a]];
+  }
   r.W = restricted_W(c, A, d);
   const Eigen::Index n = static_cast<Eigen::Index>(A.size()) * d;
   r.q.resize(n);
@@ -174,12 +189,13 @@ OperatorScales operator_scales(const LinearOperator& W, int dim, int pairs)
 
 SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScales& scales,
                            const Eigen::Ref<const Vector>& q, const Eigen::Ref<const Vector>& mu,
-                           const Eigen::Ref<const Vector>& lambda0, const SolverOptions& opt)
+                           const Eigen::Ref<const Vector>& lambda0, const SolverOptions& opt,
+                           const Vector& cap)
 {
   const Eigen::Index n = q.size();
   const int m = static_cast<int>(n / dim);
   const Matrix none(0, 0); // the four-argument residual does not read W
-  const ProblemView view{dim, none, q, mu};
+  const ProblemView view{dim, none, q, mu, cap.size() ? cap.data() : nullptr};
   const double wbar = scales.mean_normal > 0.0 ? scales.mean_normal : scales.lipschitz;
   const Vector rho = Vector::Constant(m, wbar > 0.0 ? 1.0 / wbar : 1.0);
   const double step = scales.lipschitz > 0.0 ? 1.0 / scales.lipschitz : 1.0;
@@ -187,7 +203,7 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
   SolveReport best;
   best.solver = "operator";
   Vector lam = lambda0.size() == n ? Vector(lambda0) : Vector::Zero(n);
-  project_all(lam, dim, mu);
+  project_all(lam, dim, mu, cap);
   Vector u = W(lam) + q;
   auto keep = [&](const Vector& l, const Vector& ul, double res, int it)
   {
@@ -203,12 +219,12 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
   Vector y = lam, uy = u;
   double theta = 1.0;
   int restarts = 0, it = 0;
-  const int cap = 100 * opt.max_iterations;
-  while (best.residual >= opt.tolerance && it < cap)
+  const int max_it = 100 * opt.max_iterations;
+  while (best.residual >= opt.tolerance && it < max_it)
   {
     ++it;
     Vector z = y - step * de_saxce(uy, dim, mu);
-    project_all(z, dim, mu);
+    project_all(z, dim, mu, cap);
     Vector uz = W(z) + q;
     const double res = natural_map_residual(view, z, uz, rho);
     if (!std::isfinite(res))
@@ -236,7 +252,7 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
       std::fprintf(stderr, "operator it %d residual %.3e\n", it, res);
   }
   best.converged = best.residual < opt.tolerance;
-  best.states = states_of(best.lambda, best.u, q, dim);
+  best.states = states_of(best.lambda, best.u, q, dim, cap);
   best.attempts.push_back("operator: " + std::to_string(it) + " iterations, "
                           + std::to_string(restarts) + " restarts, residual " + detail::exp3(best.residual)
                           + (best.converged ? " (converged)" : " (not converged)"));
@@ -248,7 +264,7 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
                               const Eigen::Ref<const Vector>& mu,
                               const Eigen::Ref<const Vector>& lambda0,
                               const std::vector<PairState>& states0, const SolverOptions& opt,
-                              const SameOnAllRanks& same)
+                              const SameOnAllRanks& same, const Vector& cap)
 {
   const Eigen::Index n = q.size();
   const int m = static_cast<int>(n / dim);
@@ -283,8 +299,10 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
                              + " pairs pass the memory allowed for W's columns");
       return out;
     }
-    const Restricted r = restrict_to(columns, A, dim, q, mu, out.lambda, states0);
-    const SolveReport rep = solve(ProblemView{dim, r.W, r.q, r.mu}, r.lambda, r.states, opt);
+    const Restricted r = restrict_to(columns, A, dim, q, mu, out.lambda, states0, cap);
+    const SolveReport rep = solve(
+        ProblemView{dim, r.W, r.q, r.mu, r.cap.size() ? r.cap.data() : nullptr}, r.lambda,
+        r.states, opt);
     inner += rep.iterations;
     if (same) // the chain stops on a wall-clock budget: all ranks must agree on its outcome
       same(rep.converged ? static_cast<long>(A.size()) : -1L);
@@ -317,7 +335,7 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
       out.u = std::move(u);
       out.residual = rep.residual; // bounds the whole problem's: see the header
       out.converged = true;
-      out.states = states_of(out.lambda, out.u, q, dim);
+      out.states = states_of(out.lambda, out.u, q, dim, cap);
       out.attempts.push_back("working_set: " + std::to_string(round) + " rounds, "
                              + std::to_string(A.size()) + " of " + std::to_string(m)
                              + " pairs, " + rep.solver + " " + std::to_string(inner)

@@ -23,6 +23,7 @@ from petsc4py import PETSc
 from . import _cpp
 from .condensation import Condensation
 from .memory import working_set_bytes
+from .pairing import pair_caps
 from .names import CONTACT_OPERATORS, check_option
 from .errors import InputError
 
@@ -77,14 +78,16 @@ class FactorCondensation(Condensation):
         self.n_contact_dofs = comm.bcast(self.dofs.size if root else None, root=0)
 
         # Rank 0's memory for the working set: every rank must take the same branches.
-        dofs, x, arrays, mu, constrained, self.working_set_bytes = comm.bcast(
+        dofs, x, arrays, mu, constrained, self.working_set_bytes, caps = comm.bcast(
             (self.dofs, np.asarray(pairs.x), _pair_arrays(pairs), np.asarray(mu), constrained,
-             working_set_bytes()) if root else None, root=0)
+             working_set_bytes(), pair_caps(pairs)) if root else None, root=0)
         t0 = time.perf_counter()
         self.contact = _cpp.FactorContact(dim, self.factor.handle, K.handle, dofs,
                                           self.n_virtual_dofs, x,
                                           _kernel_pairs(arrays), mu, constrained, options,
                                           self.working_set_bytes)
+        if caps is not None:
+            self.contact.set_crushing(caps)
         self.timings["delassus_s"] = time.perf_counter() - t0
         self._cached = None
 
@@ -101,7 +104,7 @@ class FactorCondensation(Condensation):
         """New pairs on the same contact nodes (rank 0's pairs and mu). Collective."""
         root = self.comm.rank == 0
         self.pairs = pairs
-        arrays, mu = self.comm.bcast((_pair_arrays(pairs), np.asarray(mu)) if root else None,
-                                     root=0)
-        self.contact.set_pairs(_kernel_pairs(arrays), mu)
+        arrays, mu, caps = self.comm.bcast(
+            (_pair_arrays(pairs), np.asarray(mu), pair_caps(pairs)) if root else None, root=0)
+        self.contact.set_pairs(_kernel_pairs(arrays), mu, np.zeros(0) if caps is None else caps)
         self._cached = None

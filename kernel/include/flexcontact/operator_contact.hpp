@@ -61,10 +61,12 @@ OperatorScales operator_scales(const LinearOperator& W, int dim, int pairs);
 /// Converged when the natural-map residual (residual.hpp) with the uniform ρ = 1/mean W_nn
 /// is below opt.tolerance; at most 100 × opt.max_iterations iterations. Returns the best
 /// iterate's report (converged=false if none met the tolerance); never throws on
-/// non-convergence.
+/// non-convergence. `cap`: the pairs' normal force caps of a crushable interface (empty:
+/// none; problem.hpp), K then the truncated cone.
 SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScales& scales,
                            const Eigen::Ref<const Vector>& q, const Eigen::Ref<const Vector>& mu,
-                           const Eigen::Ref<const Vector>& lambda0, const SolverOptions& opt);
+                           const Eigen::Ref<const Vector>& lambda0, const SolverOptions& opt,
+                           const Vector& cap = Vector());
 
 /// @brief The local problem on a working set of pairs, W never formed beyond the set's
 /// columns: start from the pairs that penetrate under q (q_n < 0) or carried a force in λ0;
@@ -78,12 +80,13 @@ SolveReport solve_operator(int dim, const LinearOperator& W, const OperatorScale
 /// memory `fetch` allows, the chain fails, or 50 rounds pass; never throws on that. After
 /// each round `same` (if given) checks that every rank took the same branch with the same
 /// set: the chain has a wall-clock budget, and ranks must not part ways in collective solves.
+/// `cap` as for solve_operator: the restricted problems keep their pairs' caps.
 SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchColumns& fetch,
                               const Eigen::Ref<const Vector>& q,
                               const Eigen::Ref<const Vector>& mu,
                               const Eigen::Ref<const Vector>& lambda0,
                               const std::vector<PairState>& states0, const SolverOptions& opt,
-                              const SameOnAllRanks& same = {});
+                              const SameOnAllRanks& same = {}, const Vector& cap = Vector());
 
 /// @brief Pairs, B, x0 and the incremental driver of CondensedContact, with F* an operator.
 ///
@@ -109,8 +112,16 @@ public:
 
   /// @brief New pairs (re-pairing): B, x0 and the scales rebuilt; slip measured from the new
   /// pairs' gap at the last contact displacement u_c = u_p,c + F* r_c (one F* product); λ
-  /// and states of slave nodes that keep a pair carried over.
-  void set_pairs(std::vector<ContactPair> pairs, Vector mu);
+  /// and states of slave nodes that keep a pair carried over. `cap`: the new pairs' caps of
+  /// a crushable interface (empty: none); the crush depth is the slave node's.
+  void set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap = Vector());
+
+  /// @brief Caps of the pairs' normal forces (docs/crushing.md; as CondensedContact's).
+  /// @throws std::invalid_argument on a wrong size or a cap ≤ 0 or NaN
+  void set_crushing(Vector cap);
+
+  /// @brief δ of every contact node [m].
+  const Vector& node_crush_depth() const { return crush_node_; }
 
   /// @brief W x = B F*(Bᵀ x), constrained contact DOFs neither loaded nor moving.
   Vector apply_W(const Vector& x) const;
@@ -147,6 +158,8 @@ private:
   Vector flex(Vector r) const;
   bool fetch_columns(const std::vector<int>& pairs);
   SolveReport solve_local(const Vector& q);
+  /// @brief δ of pair k's slave node.
+  double crush_of(int k) const;
 
   int dim_;
   LinearOperator F_;
@@ -161,6 +174,8 @@ private:
   Vector x_, lambda_;              ///< total gap and λ of the last increment
   std::vector<PairState> states_;
   Vector up_c_, reaction_;         ///< of the last increment, for u_c at re-pairing
+  Vector cap_;                     ///< per pair, empty: no crushing
+  Vector crush_node_;              ///< δ per contact node
   mutable long applications_ = 0;
   BlockOperator block_;
   double max_bytes_ = 0.0;

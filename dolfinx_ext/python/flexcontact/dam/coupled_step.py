@@ -24,12 +24,14 @@ import numpy as np
 
 from .. import _cpp
 from ..condensation import kernel_pairs
+from ..pairing import pair_caps
 from ..impact_output import contact_metrics
 from ..postprocess import _nodal_contact
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .log_model import rotation
-from .stage2 import MARGIN, approach_time_s, response_duration_s
+from .stage2 import (MARGIN, approach_time_s, force_filter_window_s, log_crushing_strength_Pa,
+                     response_duration_s)
 
 
 def expected_contact_s(s, dam) -> float:
@@ -92,6 +94,10 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
     F[n_log:, n_log:] = dam.W_face
     kernel = _cpp.ImpactContact(d, F, pairs.x, kernel_pairs(pairs), np.full(m, s.friction_mu),
                                 0.0, h, theta, None, _cpp.SolverOptions())
+    sigma_c = log_crushing_strength_Pa(s)
+    if sigma_c is not None:
+        pairs.crushing_strength = np.full(m, sigma_c)
+        kernel.set_crushing(pair_caps(pairs))
     V0 = s.log_speed_m_s * np.asarray(s.log_axis, float)
     bd, bl = _Body(dam), _Body(log)
     u_face0 = static.u.x.array[dam.face_dofs]
@@ -156,11 +162,12 @@ def _peak_pressure(out: dict, pairs, h: float) -> float:
 
 def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,
              offset_m, n) -> dict:
-    m = contact_metrics(records, h)
+    m = contact_metrics(records, h, filter_window_s=force_filter_window_s(s))
     dp = R @ log.momentum_local(bl.omega)  # the rigid part V₀ keeps its momentum
     static_heel = static.section.sigma_heel_Pa
     return {
         "peak_force_N_per_m": m["peak_force"],
+        "peak_force_filtered_N_per_m": m["peak_force_filtered"],
         "contact_duration_s": m["contact_duration_s"],
         "contact_start_s": m["contact_start_s"] if m["contact_start_s"] is not None else math.nan,
         "impulse_N_s_per_m": m["impulse"],

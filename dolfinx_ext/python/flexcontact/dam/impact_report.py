@@ -29,14 +29,21 @@ def _scenario(s: dict, log: dict) -> list:
         f"* Concrete E = {c['E_Pa'] / 1e9:g} GPa, ν = {c['nu']:g}, {c['rho_kg_m3']:g} kg/m³, "
         f"tensile strength {_mpa(s['concrete_tensile_strength_Pa'])} MPa; wood (along the "
         f"grain) E = {w['E_Pa'] / 1e9:g} GPa, {w['rho_kg_m3']:g} kg/m³, crushing strength "
-        f"{_mpa(s['wood_crushing_strength_Pa'])} MPa.", ""]
+        f"{_mpa(s['wood_crushing_strength_Pa'])} MPa parallel to the grain, green; "
+        + ("the log's front end crushes at it (docs/crushing.md)."
+           if s.get("log_end_crushes", False) else
+           "the log's end is elastic to the end (the upper bound of the force)."), ""]
 
 
-def _limits(st2: dict | None, westergaard: bool = False) -> list:
+def _limits(st2: dict | None, westergaard: bool = False, dim: int = 2) -> list:
     water = ("Westergaard's added mass of the reservoir on the upstream face included"
              if westergaard else "no Westergaard added mass of the reservoir on the dam")
+    crushes = bool(st2 and st2.get("log_end_crushes"))
+    wood = ("the log's end crushes at the wood's crushing strength, capping the contact "
+            "pressure averaged over each node's tributary measure (no rate effect)"
+            if crushes else "no wood crushing")
     out = ["## Limits of the model", "",
-           "* Linear elasticity, small strain and small rotation; no wood crushing, no "
+           f"* Linear elasticity, small strain and small rotation; {wood}, no "
            f"concrete cracking, {water}, no "
            "water damping. The ratios below say how far each neglected effect is.", ""]
     if st2:
@@ -57,10 +64,17 @@ def _limits(st2: dict | None, westergaard: bool = False) -> list:
             f"| log largest principal strain | {st2['log_max_strain']:.3g} | "
             f"{st2['log_strain_limit']:g} | {st2['log_max_strain'] / st2['log_strain_limit']:.3g} |",
             "",
-            "A pressure ratio above 1 means the wood would crush locally under the corner "
-            "that touches first (a mesh-dependent peak: the contact pressure is the mean "
-            "over a node's tributary length), which would lower the peak force; a stress "
-            "ratio above 1 would mean cracking, which the model cannot follow.", ""]
+            ("The log's end crushed by up to "
+             f"{st2.get('log_crush_depth_max_m', 0.0) * 1e3:.3g} mm, dissipating "
+             f"{st2.get('crushing_energy_J', 0.0):.4g} J"
+             + (" per metre of dam" if dim == 2 else "")
+             + "; the pressure ratio is at most 1 by the crushing law. "
+             if crushes else
+             "A pressure ratio above 1 means the wood would crush locally under the corner "
+             "that touches first (a mesh-dependent peak: the contact pressure is the mean "
+             "over a node's tributary length), which would lower the peak force. ")
+            + "A stress ratio above 1 would mean cracking, which the model cannot follow.",
+            ""]
     return out
 
 
@@ -92,7 +106,11 @@ def _stage1(st1: dict, u: dict) -> list:
 def _stage2(st2: dict, u: dict) -> list:
     return [
         "## Stage 2: the impact", "",
-        f"* Peak contact force {st2['peak_force'] / 1e6:.4g} {u['mforce']} at t = "
+        f"* Peak contact force {st2['peak_force_filtered'] / 1e6:.4g} {u['mforce']} filtered "
+        f"(centred moving average over {st2['force_filter_window_s'] * 1e3:.3g} ms, a tenth "
+        f"of the log's 2L/c: the first steps of a discrete wave front overshoot the "
+        f"plateau, a ringing of the mesh that the average removes and that keeps the exact "
+        f"pulse's plateau); raw {st2['peak_force'] / 1e6:.4g} {u['mforce']} at t = "
         f"{st2['peak_force_t_s'] * 1e3:.3f} ms; contact {st2['contact_duration_s'] * 1e3:.3f} ms "
         f"(2L/c of the log {st2['contact_duration_s_ref_log_2L_c'] * 1e3:.3f} ms); impulse "
         f"{st2['impulse']:.6e} {u['impulse']} (the log's m Δv {st2['impulse_ref']:.6e}).",
@@ -137,7 +155,7 @@ def write_report(folder, summary: dict, mesh_study: list | None = None,
     lines = ["# Floating log against a concrete gravity dam", "",
              "Written by `demos/dam_debris.py`; numbers from `summary.json` (SI, tension "
              "positive" + (", per metre of dam" if s["dim"] == 2 else "") + ").", ""]
-    lines += _scenario(s, summary["log"]) + _limits(st2, bool(s.get("westergaard"))) + _stage1(st1, unit)
+    lines += _scenario(s, summary["log"]) + _limits(st2, bool(s.get("westergaard")), s["dim"]) + _stage1(st1, unit)
     if st2:
         lines += _stage2(st2, unit)
     if mesh_study:

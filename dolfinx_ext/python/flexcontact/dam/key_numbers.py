@@ -30,6 +30,8 @@ def engineer_numbers(s, stage1, stage2) -> dict:
         "sigma_heel_before_over_tensile_strength": before.sigma_heel_Pa / ft,
         "sigma_heel_during_over_tensile_strength": ext["sigma_heel_max_Pa"] / ft,
         "peak_force": met["peak_force"],
+        "peak_force_filtered": met["peak_force_filtered"],
+        "force_filter_window_s": met["filter_window_s"],
         "peak_force_t_s": stage2.peak_time_s,
         "contact_duration_s": met["contact_duration_s"],
         "contact_duration_s_ref_log_2L_c": stage2.problem.expected_contact_s,
@@ -44,6 +46,12 @@ def engineer_numbers(s, stage1, stage2) -> dict:
         "log_rotation_limit_rad": ROTATION_LIMIT_RAD,
         "log_max_strain": stage2.log_max_strain,
         "log_strain_limit": STRAIN_LIMIT,
+        "log_end_crushes": bool(s.log_end_crushes),
+        "log_crush_depth_max_m": max((r.crush_depth_max_m for r in stage2.problem.records),
+                                     default=0.0),
+        "log_crushed_volume_m3": max((r.crushed_volume_m3 for r in stage2.problem.records),
+                                     default=0.0),
+        "crushing_energy_J": stage2.problem.energy.crushing,
     }
 
 
@@ -53,6 +61,7 @@ MESH_STUDY_COLUMNS = (
     ("sigma_toe_during_min_Pa", "toe σ min during [MPa]", 1e-6),
     ("peak_max_principal_stress_near_impact_Pa", "peak σ₁ at offset [MPa]", 1e-6),
     ("peak_force", "peak force [MN/m or MN]", 1e-6),
+    ("peak_force_filtered", "filtered peak force [MN/m or MN]", 1e-6),
     ("contact_duration_s", "duration [ms]", 1e3),
     ("impulse", "impulse [kN·s/m or kN·s]", 1e-3),
     ("peak_contact_pressure_Pa", "peak pressure [MPa]", 1e-6),

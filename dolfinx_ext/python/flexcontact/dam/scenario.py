@@ -20,6 +20,17 @@ along-grain modulus, because a log hits nearly end-on and then its axial stiffne
 the impact; the across-grain modulus is kept (``wood_E_across_grain_Pa``) for reports, not
 used by the model.
 
+With ``log_end_crushes=True`` the log's front end crushes: the log/dam interface caps the
+contact pressure, averaged over each slave node's tributary measure, at the wood's crushing
+strength parallel to the grain (docs/crushing.md). The default is False (an elastic end, the
+upper bound of the force) until the default meshes resolve the crushed patch: a pitched log's
+corner crushes over a few centimetres, less than one element of the default meshes, so the
+capped force would be σ_c times one node's tributary measure, a number of the mesh. The
+``wood_crushing_strength_Pa`` = 26.1 MPa is the mean maximum crushing strength parallel to the
+grain of green (unseasoned) coast Douglas-fir, 3,784 lbf/in², in the USDA Forest Products
+Laboratory's Wood Handbook (2010, ch. 5, Table 5-3a); green loblolly pine has 24.2 MPa
+(3,511 lbf/in²). A log carried by a flood is green: its strength is the green one.
+
 Stage-2 parameters are held and checked here too: the log's speed, the friction coefficient,
 the log's added-mass coefficient and the optional Westergaard added mass of the reservoir.
 ``added_mass_coefficient`` C_a multiplies the mass of the water the log displaces, which for
@@ -87,7 +98,8 @@ class DamScenario:
     rock: Material = ROCK
     wood: Material = WOOD
     wood_E_across_grain_Pa: float = 0.6e9
-    wood_crushing_strength_Pa: float = 20e6
+    wood_crushing_strength_Pa: float = 26.1e6
+    log_end_crushes: bool = False
     concrete_tensile_strength_Pa: float = 2.5e6
     water_density_kg_m3: float = WATER_DENSITY_KG_M3
     gravity_m_s2: float = STANDARD_GRAVITY_M_S2

@@ -21,8 +21,12 @@ Starts from stage 1 (:mod:`flexcontact.dam.stage1`) on the same mesh and functio
   (7/8) ρ_w sqrt(H_w (H_w − z)) per unit area, acting on the face's normal motion) joins
   the mass matrix (:func:`westergaard_form`); off by default.
 
-Not modelled: water damping and compressibility, the wood's across-grain softness and
-crushing.
+* the log's front end crushes at the wood's crushing strength parallel to the grain
+  (``log_end_crushes``, docs/crushing.md): where the nodal-average contact pressure reaches
+  it, the end crushes irreversibly and the force grows only with the contact area.
+
+Not modelled: water damping and compressibility, the wood's across-grain softness, a crushing
+strength that rises with the crush rate.
 """
 from __future__ import annotations
 
@@ -132,6 +136,25 @@ def sweep_time_step_s(scenarios) -> float:
     return min(steps)
 
 
+FILTER_FRACTION = 0.1
+"""The peak-force filter's window as a fraction of the log's wave round trip 2L/c
+(impact_output.contact_metrics): long enough to average out a discrete wave front's
+overshoot, short enough to keep the plateau of the exact pulse."""
+
+
+def force_filter_window_s(s) -> float:
+    """The filter window of the peak force: FILTER_FRACTION × 2L/c of the log along its axis
+    (c with the added mass, as the log moves it)."""
+    c_log = math.sqrt(s.wood.E_Pa / (s.wood.rho_kg_m3 * (1.0 + s.added_mass_coefficient)))
+    return FILTER_FRACTION * 2.0 * s.log_length_m / c_log
+
+
+def log_crushing_strength_Pa(s) -> Optional[float]:
+    """σ_c of the log's front end on the log/dam interface: the wood's crushing strength
+    parallel to the grain, or None for an elastic end (``log_end_crushes=False``)."""
+    return s.wood_crushing_strength_Pa if s.log_end_crushes else None
+
+
 def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
     """The ImpactProblem of stage 2 (collective)."""
     mesh, V = stage1.mesh, stage1.V
@@ -140,7 +163,8 @@ def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
     loads = body_loads(s, v, dx, ds)
     materials = {T.DAM: s.concrete, T.FOUNDATION: s.rock, T.LOG: log_material(s)}
     contact = ContactInterface(mesh.facet_tags, slave=T.LOG_FRONT, master=T.DAM_UPSTREAM,
-                               mu=s.friction_mu, name="log/dam", pairing="node_to_surface")
+                               mu=s.friction_mu, name="log/dam", pairing="node_to_surface",
+                               crushing_strength_Pa=log_crushing_strength_Pa(s))
     speed = s.log_speed_m_s * np.asarray(s.log_axis, dtype=float)
     return ImpactProblem(
         V, mesh.cell_tags, {"dam": T.DAM, "foundation": T.FOUNDATION, "log": T.LOG},
@@ -222,7 +246,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
             history.append((problem.t, peak))
             pressure = problem.fields()[2].x.array
             p_peak = max(p_peak, comm.allreduce(float(pressure.max(initial=0.0)), op=MPI.MAX))
-    metrics = contact_metrics(problem.records, dt)
+    metrics = contact_metrics(problem.records, dt, filter_window_s=force_filter_window_s(s))
     m_eff, v0, v1 = _log_momentum(problem)
     return Stage2Result(problem, metrics, m_eff * (v1 - v0), m_eff, v0, v1, history, impact,
                         offset_m, p_peak, {"setup": t_setup, "steps": time.perf_counter() - t0 - t_setup,

@@ -59,8 +59,9 @@ def _check_types(s):
     if not (isinstance(s.refine, numbers.Integral) and not isinstance(s.refine, bool)
             and s.refine >= 0):
         _fail("refine", s.refine, "must be an integer >= 0")
-    if not isinstance(s.westergaard, bool):
-        _fail("westergaard", s.westergaard, "must be True or False")
+    for name in ("westergaard", "log_end_crushes"):
+        if not isinstance(getattr(s, name), bool):
+            _fail(name, getattr(s, name), "must be True or False")
     for name in ("concrete", "rock", "wood"):
         if not isinstance(getattr(s, name), Material):
             _fail(name, getattr(s, name), "must be a flexcontact.forms.Material")

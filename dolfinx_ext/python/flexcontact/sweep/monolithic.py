@@ -27,7 +27,8 @@ IMPACT_OFFSET_M = 1.0
 is read (m): solve_stage2's default, and the reusing evaluator's (the corner's own stress
 grows with refinement)."""
 
-OUTPUTS = ("peak_force_N_per_m", "contact_duration_s", "impulse_N_s_per_m",
+OUTPUTS = ("peak_force_N_per_m", "peak_force_filtered_N_per_m", "contact_duration_s",
+           "impulse_N_s_per_m",
            "log_momentum_change_N_s_per_m", "heel_stress_static_Pa", "heel_stress_impact_Pa",
            "peak_tensile_stress_Pa", "peak_contact_pressure_Pa", "steps")
 """The evaluator's outputs (plain floats; ``steps`` an integer)."""
@@ -68,6 +69,7 @@ class MonolithicEvaluator:
                   p.back_substitutions + int(p.flex_info.get("solves", 0)))
         m = st2.metrics
         out = {"peak_force_N_per_m": m["peak_force"],
+               "peak_force_filtered_N_per_m": m["peak_force_filtered"],
                "contact_duration_s": m["contact_duration_s"],
                "impulse_N_s_per_m": m["impulse"],
                "log_momentum_change_N_s_per_m": st2.log_momentum_change,
