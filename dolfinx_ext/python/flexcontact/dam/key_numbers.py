@@ -29,6 +29,10 @@ def engineer_numbers(s, stage1, stage2) -> dict:
         "moment_heel_during_max_Nm": ext["moment_heel_max_Nm"],
         "sigma_heel_before_over_tensile_strength": before.sigma_heel_Pa / ft,
         "sigma_heel_during_over_tensile_strength": ext["sigma_heel_max_Pa"] / ft,
+        # The impact's own change: the static part is exact on any mesh (the section's
+        # statics), so it must not dilute the mesh study's error.
+        "delta_sigma_heel_Pa": ext["sigma_heel_max_Pa"] - before.sigma_heel_Pa,
+        "delta_sigma_toe_Pa": ext["sigma_toe_min_Pa"] - before.sigma_toe_Pa,
         "peak_force": met["peak_force"],
         "peak_force_filtered": met["peak_force_filtered"],
         "force_filter_window_s": met["filter_window_s"],
@@ -67,6 +71,22 @@ MESH_STUDY_COLUMNS = (
     ("peak_contact_pressure_Pa", "peak pressure [MPa]", 1e-6),
 )
 """(key, heading, scale) of the mesh-study table."""
+
+CONVERGENCE_QUANTITIES = (
+    ("delta_sigma_heel_Pa", "Δσ heel (impact) [MPa]", 1e-6),
+    ("delta_sigma_toe_Pa", "Δσ toe (impact) [MPa]", 1e-6),
+    ("peak_max_principal_stress_near_impact_Pa", "peak σ₁ at offset [MPa]", 1e-6),
+    ("peak_force_filtered", "filtered peak force [MN/m or MN]", 1e-6),
+    ("impulse", "impulse [kN·s/m or kN·s]", 1e-3),
+)
+"""(key, heading, scale) of the quantities whose convergence the study estimates."""
+
+
+def study_scenarios(s, ratio: float) -> list:
+    """The mesh study's three scenarios: ``s`` (the default mesh) and s with every element
+    size divided by ratio and by ratio², near field and far field together."""
+    return [s] + [s.replace(refine=0, mesh_size_far_m=s.h_far_m / ratio ** k,
+                            mesh_size_impact_m=s.h_impact_m / ratio ** k) for k in (1, 2)]
 
 
 def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None) -> dict:

@@ -38,7 +38,7 @@ from .errors import ConfigError
 
 SWEPT = ("log_length_m", "log_diameter_m", "wood_density_kg_m3", "log_speed_m_s",
          "log_pitch_deg", "log_yaw_deg", "friction_mu", "water_level_m",
-         "added_mass_coefficient")
+         "added_mass_coefficient", "wood_crushing_strength_Pa")
 """Inputs a sweep may vary; ``wood_density_kg_m3`` is the wood Material's ``rho_kg_m3``."""
 METHODS = ("grid", "lhs", "random")
 ENGINES = ("serial", "processes", "mpi", "dask")
