@@ -7,14 +7,21 @@
 # pressure on the upstream face (optionally tailwater and uplift); then **stage 2**, the
 # log's impact on the upstream face, starting from this state (`--stage1-only` skips it).
 #
+# By default the dam is a plane-strain section (per metre of dam: a raft of logs abreast
+# along the whole crest, not one log); `--dim 3` runs a 3D block between contraction joints
+# (15 m wide) with a round, flat-ended log. The log's end is elastic (the upper bound of the
+# force) unless `--log-end-crushes`: then it crushes at the wood's crushing strength
+# (docs/crushing.md), and the mesh is refined about the first-contact point so that the
+# crushed patch at the peak force spans at least four elements (CRUSHED_PATCH_MESH).
+#
 # What is measured: the base section's normal force N, shear and moment M from the nodal
 # forces the dam hands to the foundation, against the hand statics of the dam's free body
 # (self-weight, and the hydrostatic resultant ρ_w g h²/2 acting at h/3); these are exact in
 # statics, so they agree to round-off. From them, the linearised heel and toe stresses
 # σ = −N/B ± 6M/B² that dam engineers use (per metre of dam in 2D).
 #
-# Run: `/usr/bin/python3 demos/dam_debris.py [--refine N] [--water-level 27] [--dim 3]
-# [--stage1-only] [--mesh-study]`;
+# Run: `/usr/bin/python3 demos/dam_debris.py [--dim 3] [--refine N] [--water-level 27]
+# [--log-end-crushes] [--stage1-only] [--mesh-study]`;
 # results go to `results/dam_debris/`, with a short report `report.md`.
 
 # %%
@@ -50,6 +57,12 @@ parser.add_argument("--gap", type=float, default=0.02, help="log to face, m")
 parser.add_argument("--mu", type=float, default=0.5, help="friction coefficient (stage 2)")
 parser.add_argument("--log-end-crushes", action="store_true",
                     help="the log's front end crushes at the wood's crushing strength")
+parser.add_argument("--contact-size", type=float, default=None,
+                    help="element size (m) within --contact-zone of the first-contact point "
+                         "(default with --log-end-crushes: CRUSHED_PATCH_MESH of the "
+                         "dimension; without: the impact zone's)")
+parser.add_argument("--contact-zone", type=float, default=None,
+                    help="radius (m) of the refined ball about the first-contact point")
 parser.add_argument("--offset", type=float, default=1.0,
                     help="distance from the heel at which the peak stress is reported, m")
 parser.add_argument("--stage1-only", action="store_true", help="skip the impact (stage 2)")
@@ -77,12 +90,15 @@ t_start = time.perf_counter()
 # meshed. The log's elevation is not an input: it floats at its draft.
 
 # %%
+from flexcontact.dam.scenario import CRUSHED_PATCH_MESH
+size, zone = CRUSHED_PATCH_MESH[args.dim] if args.log_end_crushes else (None, 0.1)
 scenario = DamScenario(
     dim=args.dim, refine=args.refine, water_level_m=args.water_level,
     tailwater_level_m=args.tailwater, uplift_factor=args.uplift,
     log_speed_m_s=args.log_speed, log_pitch_deg=args.log_pitch, log_yaw_deg=args.log_yaw,
     log_length_m=args.log_length, log_diameter_m=args.log_diameter, log_gap_m=args.gap,
-    friction_mu=args.mu, westergaard=args.westergaard, log_end_crushes=args.log_end_crushes)
+    friction_mu=args.mu, westergaard=args.westergaard, log_end_crushes=args.log_end_crushes,
+    mesh_size_contact_m=args.contact_size or size, contact_zone_m=args.contact_zone or zone)
 folder = fc.results_folder("dam_debris")
 
 # %% [markdown]
@@ -244,7 +260,7 @@ if not args.stage1_only:
 # ## ParaView picture
 # The dam at the step of the peak contact force, warped so that its displacement shows
 # (scale: the dam's largest displacement drawn as 5 % of its height), coloured by the largest
-# principal stress (red: tension). Rendered by `pvbatch` under `xvfb-run` if ParaView is
+# principal stress (red: tension) on ±2 × the concrete's tensile strength (saturated beyond). Rendered by `pvbatch` under `xvfb-run` if ParaView is
 # installed; otherwise the report says so.
 
 # %%
@@ -254,9 +270,12 @@ if not args.stage1_only and not args.no_paraview:
     paraview = (False, "not rendered")
     scale = warp_scale(peak_u, cells, dam_tags.DAM, s.dam_height_m)
     if comm.rank == 0:
+        # Saturated at twice the concrete's tensile strength: the contact point's singular
+        # peak would otherwise wash out the dam's stress field.
         paraview = render_stress_picture(folder / "impact_peak.xdmf",
                                          folder / "stress_paraview.png", scale,
-                                         body_tag=dam_tags.DAM)
+                                         body_tag=dam_tags.DAM,
+                                         bound=2.0 * s.concrete_tensile_strength_Pa)
         print(("ParaView picture: " if paraview[0] else "no ParaView picture: ") + paraview[1])
     paraview = comm.bcast(paraview, root=0)
 

@@ -86,11 +86,13 @@ def physical(dim: int, entities, tag: int, name: str):
 
 
 def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float,
-               dist_far: float, points_per_curve: int = 20, boxes=()):
+               dist_far: float, points_per_curve: int = 20, boxes=(), balls=()):
     """Background mesh size (m): h_near within dist_near of the ``dim``-entities (curves or
     surfaces), growing linearly to h_far at dist_far. ``boxes``: extra caps
     ``(size, x0, y0, z0, x1, y1, z1)``; inside such a box the size never exceeds ``size``.
-    Sizes from points and curvature are switched off."""
+    ``balls``: caps ``(size, x, y, z, radius, thickness)``, the size inside the ball of that
+    radius, blending to the rest over ``thickness``. Sizes from points and curvature are
+    switched off."""
     field = gmsh.model.mesh.field
     f_dist = field.add("Distance")
     field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[dim], list(entities))  # 4.8 names
@@ -109,6 +111,12 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
         field.setNumber(f_box, "VIn", size)
         field.setNumber(f_box, "VOut", h_far)
         fields.append(f_box)
+    for size, x, y, z, radius, thickness in balls:
+        f_ball = field.add("Ball")
+        for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
+                         ("Thickness", thickness), ("VIn", size), ("VOut", h_far)):
+            field.setNumber(f_ball, key, val)
+        fields.append(f_ball)
     if len(fields) > 1:
         f_min = field.add("Min")
         field.setNumbers(f_min, "FieldsList", fields)

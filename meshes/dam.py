@@ -70,7 +70,23 @@ def _refine_near_log(s, log_entities, dim):
     near = s.impact_zone_m
     far = near + 2.0 * (s.h_far_m - s.h_impact_m)  # growth rate 1/2: well-shaped grading
     _gmsh.size_field(log_entities, dim, s.h_impact_m, s.h_far_m, near, far,
-                     points_per_curve=max(20, int(4 * s.log_length_m / s.h_impact_m)))
+                     points_per_curve=max(20, int(4 * s.log_length_m / s.h_impact_m)),
+                     balls=_contact_ball(s))
+
+
+def _contact_ball(s) -> tuple:
+    """The size cap around the first-contact point (scenario ``mesh_size_contact_m``), where
+    a crushing end's patch must be resolved: a ball of radius ``contact_zone_m`` about the
+    point halfway between the log's front point and the face, blending to h_impact over
+    a growth of 1/2."""
+    if s.h_contact_m >= s.h_impact_m:
+        return ()
+    front = np.asarray(s.log_front_point, float)
+    centre = front.copy()
+    centre[0] = 0.5 * front[0]
+    x, y, z = (centre[0], centre[1], 0.0) if s.dim == 2 else tuple(centre)
+    return ((s.h_contact_m, float(x), float(y), float(z), s.contact_zone_m,
+             2.0 * (s.h_impact_m - s.h_contact_m)),)
 
 
 def _model_2d(s, info):

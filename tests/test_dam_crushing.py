@@ -80,3 +80,37 @@ def test_crushing_strength_is_a_sweep_input(tmp_path):
     for r in rows:
         sigma_c = float(r["wood_crushing_strength_Pa"])
         assert float(r["peak_contact_pressure_Pa"]) == pytest.approx(sigma_c, rel=1e-8)
+
+
+def test_the_contact_ball_refines_the_first_contact_point():
+    """mesh_size_contact_m: elements of about that size within contact_zone_m of the first
+    contact point (2D), the rest of the mesh as without it."""
+    from flexcontact.meshes import dam as dam_mesh
+    coarse = DamScenario()
+    fine = coarse.replace(mesh_size_contact_m=0.0125, contact_zone_m=0.1)
+    sizes = {}
+    for name, s in (("coarse", coarse), ("fine", fine)):
+        mesh = dam_mesh.build(COMM, s)
+        msh = mesh.msh if hasattr(mesh, "msh") else mesh[0]
+        x = msh.geometry.x[:, :2]
+        cells = msh.geometry.dofmap
+        cells = cells.array.reshape(-1, 3) if hasattr(cells, "array") else np.asarray(cells)
+        centre = np.asarray(s.log_front_point)
+        # The cells with a vertex within 3 cm of the corner (a vertex of the log's mesh).
+        near = (np.linalg.norm(x[cells] - centre, axis=2) <= 0.03).any(axis=1)
+        edges = np.linalg.norm(x[cells] - x[np.roll(cells, 1, axis=1)], axis=2)
+        sizes[name] = (edges[near].max(), cells.shape[0])
+    assert sizes["fine"][0] <= 1.5 * 0.0125
+    assert sizes["coarse"][0] >= 0.1
+    assert sizes["fine"][1] < 2 * sizes["coarse"][1]
+
+
+@pytest.mark.parametrize("change, words", [({"mesh_size_contact_m": 0.0}, "mesh_size_contact_m"),
+                                           ({"contact_zone_m": -1.0}, "contact_zone_m"),
+                                           ({"log_end_crushes": "yes"}, "log_end_crushes"),
+                                           ({"wood_crushing_strength_Pa": 0.0},
+                                            "wood_crushing_strength_Pa")])
+def test_bad_crushing_inputs_are_named_before_meshing(change, words):
+    from flexcontact.errors import InputError
+    with pytest.raises(InputError, match=words):
+        DamScenario(**change)

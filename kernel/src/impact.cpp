@@ -275,17 +275,29 @@ double ImpactContact::crush_of(int k) const
 
 void ImpactContact::crush(ImpactStep& r)
 {
-  // The surface crushes at the rate the pair closes while its impulse is at the cap: over
-  // the step, h max(0, −U_n^θ), with the θ-velocity of the scheme's energy balance, so that
-  // the crushing work is exactly the crushing pairs' part of contact_work.
+  // A pair at its cap crushes by what its crushed surface would otherwise overlap at the end
+  // of the step, −(g_n + δ + h U_n^θ) (the gap moves by h U_n^θ, the θ-velocity of the
+  // scheme's energy balance), but by no more than the surfaces approached in the step,
+  // h max(0, −U_n^θ). While it crushes, g + δ stays at zero and the two agree. Measured from
+  // the gap, the increment is continuous where a pair reaches its cap within the step, so
+  // the answer does not hang on which side of the cap the rounding puts the impulse; the
+  // bound keeps a gap the velocity-level scheme let drift from counting as crush, so the
+  // crushing work (capped force × increment) never exceeds the pair's share of the contact
+  // work and the contact dissipation stays ≥ 0.
   const int d = dim_;
   const Vector Utheta = theta_ * r.velocity + (1.0 - theta_) * r.velocity_before;
   for (int k = 0; k < pairs(); ++k)
-    if (r.states[k] == PairState::crush && Utheta[k * d] < 0.0)
+  {
+    if (r.states[k] != PairState::crush)
+      continue;
+    const double approach = -dt_ * Utheta[k * d];
+    const double overlap = std::min(-(r.gap[k * d] + crush_of(k)) + approach, approach);
+    if (overlap > 0.0)
     {
-      crush_node_[pairs_[static_cast<std::size_t>(k)].slave] += -dt_ * Utheta[k * d];
-      r.crush_work += -r.impulse[k * d] * Utheta[k * d];
+      crush_node_[pairs_[static_cast<std::size_t>(k)].slave] += overlap;
+      r.crush_work += r.impulse[k * d] / dt_ * overlap;
     }
+  }
   r.crush_depth.resize(pairs());
   for (int k = 0; k < pairs(); ++k)
     r.crush_depth[k] = crush_of(k);

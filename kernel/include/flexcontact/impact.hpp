@@ -48,8 +48,8 @@ struct ImpactStep
   double friction_work = 0.0;
   /// Σ_k P_k·U_k^θ: the work of all contact impulses in the scheme's energy balance
   double contact_work = 0.0;
-  /// Σ_k P_n,k max(0, −U_n,k^θ) over the crushing pairs: the part of contact_work the
-  /// crushing dissipated (≥ 0; minus it is in contact_work), h·cap·Δδ summed
+  /// Σ_k (P_n,k/h) Δδ_k over the crushing pairs: the capped force times the crush
+  /// increment, the part of −contact_work the crushing dissipated (≥ 0)
   double crush_work = 0.0;
   Vector crush_depth;             ///< m, δ of each pair's slave after the step (empty: no cap)
   /// max(0, −min_k (g_n,k + δ_k)) at the start of the step: the crushed surface's overlap
@@ -121,8 +121,10 @@ public:
   /// @brief Caps c_k > 0 of the pairs' normal contact forces [N; N/m in 2D] (+∞: none;
   /// empty: no crushing), kept until the next set_pairs. The impulse of a step is capped
   /// at c_k h. Where the cap binds the pair's surface crushes: its slave node's crush depth
-  /// δ (zero at first, carried across re-pairing) grows by h·max(0, −U_n^θ), and the gap
-  /// of the index set and of the next steps is g_n + δ (docs/crushing.md).
+  /// δ (zero at first, carried across re-pairing) grows by the overlap the crushed surface
+  /// would have at the end of the step, −(g_n + δ + h U_n^θ), at most the step's approach
+  /// h max(0, −U_n^θ); the gap of the index set and of the next steps is g_n + δ
+  /// (docs/crushing.md).
   /// @throws std::invalid_argument on a wrong size or a cap ≤ 0 or NaN
   void set_crushing(Vector cap);
 

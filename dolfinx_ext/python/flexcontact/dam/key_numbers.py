@@ -56,6 +56,8 @@ def engineer_numbers(s, stage1, stage2) -> dict:
         "log_crushed_volume_m3": max((r.crushed_volume_m3 for r in stage2.problem.records),
                                      default=0.0),
         "crushing_energy_J": stage2.problem.energy.crushing,
+        "crushing_pairs_max": max((r.crush for r in stage2.problem.records), default=0),
+        "contact_element_size_m": s.h_contact_m,
     }
 
 
@@ -85,8 +87,11 @@ CONVERGENCE_QUANTITIES = (
 def study_scenarios(s, ratio: float) -> list:
     """The mesh study's three scenarios: ``s`` (the default mesh) and s with every element
     size divided by ratio and by ratio², near field and far field together."""
+    contact = s.mesh_size_contact_m is not None
     return [s] + [s.replace(refine=0, mesh_size_far_m=s.h_far_m / ratio ** k,
-                            mesh_size_impact_m=s.h_impact_m / ratio ** k) for k in (1, 2)]
+                            mesh_size_impact_m=s.h_impact_m / ratio ** k,
+                            mesh_size_contact_m=s.h_contact_m / ratio ** k if contact else None)
+                  for k in (1, 2)]
 
 
 def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None) -> dict:

@@ -13,16 +13,20 @@ SCRIPT = Path(__file__).with_name("pv_stress_picture.py")
 
 def render_stress_picture(xdmf_path, png_path, scale: float,
                           field: str = "max_principal_stress_Pa", body_tag=None,
-                          timeout_s: float = 120.0) -> tuple[bool, str]:
+                          timeout_s: float = 120.0,
+                          bound: float | None = None) -> tuple[bool, str]:
     """Render the last time of ``xdmf_path`` warped by ``scale`` and coloured by ``field``
-    (cells tagged ``body_tag`` only, if given) to ``png_path``. Returns (done, message):
-    done is False, with the reason, when pvbatch or xvfb-run is missing or fails."""
+    (cells tagged ``body_tag`` only, if given) to ``png_path``, on the colour scale
+    ±``bound`` (values beyond it saturate; None: the field's largest magnitude). Returns
+    (done, message): done is False, with the reason, when pvbatch or xvfb-run is missing
+    or fails."""
     pvbatch, xvfb = shutil.which("pvbatch"), shutil.which("xvfb-run")
     if pvbatch is None:
-        return False, "pvbatch not found (Debian package paraview)"
+        return False, "pvbatch not found (Debian packages paraview, python3-paraview)"
     cmd = [pvbatch, str(SCRIPT), str(xdmf_path), str(png_path), repr(float(scale)), field]
-    if body_tag is not None:
-        cmd.append(str(int(body_tag)))
+    cmd.append(str(int(body_tag)) if body_tag is not None else "all")
+    if bound is not None:
+        cmd.append(repr(float(bound)))
     if xvfb is not None:
         # xvfb-run's default screen (8-bit, no GLX) cannot host an OpenGL window.
         cmd = [xvfb, "-a", "-s", "-screen 0 1280x1024x24 +extension GLX", *cmd]

@@ -1,11 +1,12 @@
 """Run by ParaView's pvbatch (not imported by flexcontact): a picture of the dam's stress.
 
-    pvbatch pv_stress_picture.py FILE.xdmf OUT.png SCALE FIELD [BODY_TAG]
+    pvbatch pv_stress_picture.py FILE.xdmf OUT.png SCALE FIELD [BODY_TAG|all [BOUND]]
 
 Reads the last time of FILE.xdmf, keeps the cells whose ``cell_tag`` is BODY_TAG (the
 dam) if given, warps them by ``displacement_m`` × SCALE, colours them by the cell field
-FIELD (blue-white-red, symmetric about zero so that tension is red) and saves OUT.png
-(1200 × 800). Needs a display: run it under xvfb-run.
+FIELD (blue-white-red, symmetric about zero so that tension is red, on ±BOUND if given:
+beyond it the colours saturate, so that a singular peak does not wash out the rest) and
+saves OUT.png (1200 × 800). Needs a display: run it under xvfb-run.
 """
 import sys
 
@@ -19,7 +20,7 @@ reader.UpdatePipelineInformation()
 times = reader.TimestepValues
 t = times if isinstance(times, float) else (list(times) or [0.0])[-1]
 source = reader
-if len(sys.argv) > 5:
+if len(sys.argv) > 5 and sys.argv[5] != "all":
     tag = float(sys.argv[5])
     source = Threshold(Input=reader)
     source.Scalars = ["CELLS", "cell_tag"]
@@ -43,11 +44,12 @@ ColorBy(shown, ("CELLS", field))
 lut = GetColorTransferFunction(field)
 lut.ApplyPreset("Cool to Warm", True)
 lo, hi = warp.CellData[field].GetRange()
-bound = max(abs(lo), abs(hi), 1e-30)
+bound = float(sys.argv[6]) if len(sys.argv) > 6 else max(abs(lo), abs(hi), 1e-30)
 lut.RescaleTransferFunction(-bound, bound)
 shown.SetScalarBarVisibility(view, True)
 bar = GetScalarBar(lut, view)
-bar.Title = f"{field} (displacement ×{scale:.3g})"
+bar.Title = (f"{field} (displacement ×{scale:.3g}"
+             + (", saturated" if len(sys.argv) > 6 else "") + ")")
 bar.ComponentTitle = ""
 bar.TitleColor = [0.0, 0.0, 0.0]
 bar.LabelColor = [0.0, 0.0, 0.0]

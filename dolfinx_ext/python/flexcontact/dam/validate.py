@@ -17,7 +17,7 @@ _POSITIVE = ("dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
              "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
              "water_level_m", "log_length_m", "log_diameter_m", "wood_E_across_grain_Pa",
              "wood_crushing_strength_Pa", "concrete_tensile_strength_Pa",
-             "water_density_kg_m3", "gravity_m_s2", "impact_zone_m")
+             "water_density_kg_m3", "gravity_m_s2", "impact_zone_m", "contact_zone_m")
 _NON_NEGATIVE = ("tailwater_level_m", "log_gap_m", "log_speed_m_s", "friction_mu",
                  "added_mass_coefficient")
 
@@ -52,7 +52,7 @@ def _check_types(s):
                    "log_speed_m_s": "the log's speed must be >= 0 m/s (it moves towards the "
                                     "dam; the direction is its axis)"}.get(name, "must be >= 0")
             _fail(name, v, why)
-    for name in ("mesh_size_far_m", "mesh_size_impact_m"):
+    for name in ("mesh_size_far_m", "mesh_size_impact_m", "mesh_size_contact_m"):
         v = getattr(s, name)
         if v is not None and not (_real(v) and v > 0):
             _fail(name, v, "must be None (default) or a finite number > 0")
