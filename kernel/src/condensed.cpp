@@ -82,9 +82,7 @@ void CondensedContact::set_flexibility(Matrix Fstar)
 void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
 {
   detail::check_mu_count(mu, pairs.size(), who);
-  if (cap.size() != 0 && cap.size() != static_cast<Eigen::Index>(pairs.size()))
-    throw std::invalid_argument(who + "set_pairs: cap has " + std::to_string(cap.size())
-                                + " entries for " + std::to_string(pairs.size()) + " pairs");
+  detail::check_caps(cap, pairs.size(), who + "set_pairs: ");
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);

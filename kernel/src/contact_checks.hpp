@@ -56,6 +56,21 @@ inline void check_mu_count(const Vector& mu, std::size_t pairs, const std::strin
                                 + " entries but there are " + std::to_string(pairs) + " pairs");
 }
 
+/// @brief Throws unless `cap` is empty (no crushing) or holds one normal force cap per pair,
+/// each > 0 (+∞: that pair has none), naming the first bad one (docs/crushing.md).
+inline void check_caps(const Vector& cap, std::size_t pairs, const std::string& who)
+{
+  if (cap.size() == 0)
+    return;
+  if (static_cast<std::size_t>(cap.size()) != pairs)
+    throw std::invalid_argument(who + "cap has " + std::to_string(cap.size())
+                                + " entries but there are " + std::to_string(pairs) + " pairs");
+  for (Eigen::Index k = 0; k < cap.size(); ++k)
+    if (!(cap[k] > 0.0))
+      throw std::invalid_argument(who + "the normal force cap of pair " + std::to_string(k)
+                                  + " is " + num(cap[k]) + "; it must be > 0 (+inf: no cap)");
+}
+
 /// @brief Throws naming the first friction coefficient that is negative or not finite.
 inline void check_friction(const Vector& mu, const std::string& who)
 {

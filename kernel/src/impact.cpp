@@ -41,19 +41,6 @@ void check_vector(const char* name, const Eigen::Ref<const Vector>& v, Eigen::In
   detail::check_contact_values(who + "step: ", name, v, n);
 }
 
-/// @brief Throws unless cap is empty or has m entries, each > 0 (+∞ allowed).
-void check_cap(const Vector& cap, std::size_t m)
-{
-  if (cap.size() == 0)
-    return;
-  if (cap.size() != static_cast<Eigen::Index>(m))
-    throw std::invalid_argument(who + "cap has " + std::to_string(cap.size()) + " entries for "
-                                + std::to_string(m) + " pairs");
-  for (Eigen::Index k = 0; k < cap.size(); ++k)
-    if (!(cap[k] > 0.0))
-      throw std::invalid_argument(who + "the force cap of pair " + std::to_string(k) + " is "
-                                  + num(cap[k]) + "; it must be > 0 (+inf: no cap)");
-}
 } // namespace
 
 ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<ContactPair> pairs,
@@ -85,7 +72,7 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
 
 void ImpactContact::set_crushing(Vector cap)
 {
-  check_cap(cap, pairs_.size());
+  detail::check_caps(cap, pairs_.size(), who);
   cap_ = std::move(cap);
 }
 
@@ -102,7 +89,7 @@ void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
 void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
 {
   check_mu(mu, pairs.size());
-  check_cap(cap, pairs.size());
+  detail::check_caps(cap, pairs.size(), who);
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);

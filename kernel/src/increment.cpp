@@ -136,11 +136,9 @@ void IncrementalSolver::set_crushing(Vector cap, Vector crush_depth)
                                 + " and crush_depth " + std::to_string(crush_depth.size())
                                 + " entries, expected one per pair (" + std::to_string(pairs())
                                 + ")");
+  detail::check_caps(cap, static_cast<std::size_t>(pairs()), who);
   for (int k = 0; k < pairs(); ++k)
   {
-    if (!(cap[k] > 0.0))
-      throw std::invalid_argument(who + "the cap of pair " + std::to_string(k) + " is "
-                                  + num(cap[k]) + "; it must be > 0 (+inf: no cap)");
     if (!(crush_depth[k] >= 0.0) || !std::isfinite(crush_depth[k]))
       throw std::invalid_argument(who + "the crush depth of pair " + std::to_string(k)
                                   + " is " + num(crush_depth[k])

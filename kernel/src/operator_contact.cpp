@@ -38,13 +38,7 @@ OperatorContact::OperatorContact(int dim, LinearOperator flexibility, Matrix X,
 
 void OperatorContact::set_crushing(Vector cap)
 {
-  if (cap.size() != 0 && cap.size() != pairs())
-    throw std::invalid_argument(who + "set_crushing: cap has " + std::to_string(cap.size())
-                                + " entries for " + std::to_string(pairs()) + " pairs");
-  for (Eigen::Index k = 0; k < cap.size(); ++k)
-    if (!(cap[k] > 0.0))
-      throw std::invalid_argument(who + "the cap of pair " + std::to_string(k) + " is "
-                                  + detail::num(cap[k]) + "; it must be > 0 (+inf: no cap)");
+  detail::check_caps(cap, pairs_.size(), who + "set_crushing: ");
   cap_ = std::move(cap);
 }
 
@@ -74,13 +68,7 @@ void OperatorContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vecto
 {
   detail::check_mu_count(mu, pairs.size(), who);
   detail::check_friction(mu, who);
-  if (cap.size() != 0 && cap.size() != static_cast<Eigen::Index>(pairs.size()))
-    throw std::invalid_argument(who + "set_pairs: cap has " + std::to_string(cap.size())
-                                + " entries for " + std::to_string(pairs.size()) + " pairs");
-  for (Eigen::Index k = 0; k < cap.size(); ++k)
-    if (!(cap[k] > 0.0))
-      throw std::invalid_argument(who + "the cap of pair " + std::to_string(k) + " is "
-                                  + detail::num(cap[k]) + "; it must be > 0 (+inf: no cap)");
+  detail::check_caps(cap, pairs.size(), who + "set_pairs: ");
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
   // Slip of the next increment is measured from the new pairs' gap where the bodies are.
