@@ -8,13 +8,20 @@
 # Haehnel & Daly (F = v √(k m), k = 2.4 MN/m), EN 1991-1-7 Annex C with the log as an
 # elastic bar (k = EA/L) and Matsutomi's driftwood fit. See docs/dam.md for why they differ.
 #
+# Two model columns: the log's end elastic (the upper bound of the force), and the log's
+# flat end crushing at the wood's crushing strength (docs/crushing.md) on a mesh that
+# resolves the crushed patch (`scenario.CRUSHED_PATCH_MESH`). Both are the filtered peak
+# force (a centred moving average over a tenth of the log's 2L/c, docs/impact.md).
+# Elastic, the model is linear in the speed; crushing, it is not, so each speed is a run.
+#
 # With `--dim 2` the plane-strain section is used instead and its force per metre is
 # multiplied by the log's diameter (the width a log occupies), a rough conversion stated
 # in the table.
 #
 # Run: `/usr/bin/python3 demos/dam_design_formulas.py [--speeds 1 2 4] [--lengths 5 10]
-# [--dim 3]`; about a minute per run of the 3D coarse mesh here. Results in
-# `results/dam_design_formulas/` (CSV, markdown table, PNG, summary.json).
+# [--dim 3] [--no-crushing]`; about a minute per elastic run of the 3D coarse mesh here, two
+# to three per crushing run. Results in `results/dam_design_formulas/` (CSV, markdown
+# table, PNG, summary.json).
 
 # %%
 import argparse
@@ -36,6 +43,8 @@ parser.add_argument("--speeds", type=float, nargs="+", default=[1.0, 2.0, 4.0], 
 parser.add_argument("--lengths", type=float, nargs="+", default=[5.0, 10.0],
                     help="log lengths, m (the mass follows)")
 parser.add_argument("--refine", type=int, default=0)
+parser.add_argument("--no-crushing", action="store_true",
+                    help="skip the crushing-end column (elastic end only)")
 parser.add_argument("--no-plot", action="store_true")
 args = parser.parse_args()
 comm = MPI.COMM_WORLD
@@ -65,25 +74,50 @@ def mesh_gap_m(stage1) -> float:
     return -comm.allreduce(front, op=MPI.MAX)
 
 
+from flexcontact.dam.scenario import CRUSHED_PATCH_MESH
+
+
+def impact(s, stage1, gap):
+    """Stage 2 of ``s`` from ``stage1``, long enough for the contact to end."""
+    approach = approach_time_s(s) * gap / s.log_gap_m
+    duration = approach + 3.0 * default_time_step_s(s, steps_in_contact=1)
+    r = solve_stage2(s, stage1, duration_s=duration, stress_every=10**9, comm=comm)
+    return r, duration
+
+
 rows = []
 for length in args.lengths:
     base = DamScenario(dim=args.dim, refine=args.refine, log_length_m=length)
     stage1 = solve_stage1(base, comm=comm)
     gap = max(mesh_gap_m(stage1), base.log_gap_m)
+    crushing = None
+    if not args.no_crushing:
+        size, zone = CRUSHED_PATCH_MESH[args.dim]
+        crushing = base.replace(log_end_crushes=True, mesh_size_contact_m=size,
+                                contact_zone_m=zone)
+        stage1_c = solve_stage1(crushing, comm=comm)
+        gap_c = max(mesh_gap_m(stage1_c), crushing.log_gap_m)
     for v in args.speeds:
         s = base.replace(log_speed_m_s=v)
-        approach = approach_time_s(s) * gap / s.log_gap_m
-        duration = approach + 3.0 * default_time_step_s(s, steps_in_contact=1)
-        r = solve_stage2(s, stage1, duration_s=duration, stress_every=10**9, comm=comm)
+        r, duration = impact(s, stage1, gap)
         m = s.log_mass_kg()
         width = 1.0 if s.dim == 3 else s.log_diameter_m
-        F = r.metrics["peak_force"] * width
+        F = r.metrics["peak_force_filtered"] * width
         row = {"length_m": length, "mass_kg": m, "speed_m_s": v,
-               "computed_N": F, "contact_s": r.metrics["contact_duration_s"],
+               "computed_N": F, "computed_raw_N": r.metrics["peak_force"] * width,
+               "contact_s": r.metrics["contact_duration_s"],
                "impulse_N_s": r.metrics["impulse"] * width,
                "episodes": r.metrics["episodes"], "mesh_gap_m": gap,
                "contact_ended": bool(r.metrics["contact_end_s"] is not None
                                      and r.metrics["contact_end_s"] < duration - 1e-12)}
+        if crushing is not None:
+            rc, _ = impact(crushing.replace(log_speed_m_s=v), stage1_c, gap_c)
+            Fc = rc.metrics["peak_force_filtered"] * width
+            row.update(computed_crushing_N=Fc,
+                       crush_depth_m=max((x.crush_depth_max_m for x in rc.problem.records),
+                                         default=0.0),
+                       k_effective_crushing_N_m=Fc * Fc
+                       / (m * (1 + s.added_mass_coefficient) * v * v))
         row.update({k: f for k, f in dfm.all_formulas_N(
             m, v, s.log_diameter_m, length, s.wood.E_Pa, s.wood.rho_kg_m3,
             s.wood_crushing_strength_Pa).items()})
@@ -91,8 +125,10 @@ for length in args.lengths:
         row["k_effective_N_m"] = F * F / (m * (1 + s.added_mass_coefficient) * v * v)
         rows.append(row)
         if comm.rank == 0:
+            crushed = (f", crushing end {row['computed_crushing_N'] / 1e6:.3f} MN"
+                       if crushing is not None else "")
             print(f"L = {length:g} m (m = {m:.0f} kg), v = {v:g} m/s: computed "
-                  f"{F / 1e6:.3f} MN; ASCE 7 {row['asce7'] / 1e6:.3f}, Haehnel & Daly "
+                  f"{F / 1e6:.3f} MN elastic{crushed}; ASCE 7 {row['asce7'] / 1e6:.3f}, Haehnel & Daly "
                   f"{row['haehnel_daly'] / 1e6:.3f}, EN 1991-1-7 bar "
                   f"{row['eurocode_bar'] / 1e6:.3f}, Matsutomi {row['matsutomi'] / 1e6:.3f} MN",
                   flush=True)
@@ -101,8 +137,10 @@ for length in args.lengths:
 # ## The table and the plot
 
 # %%
-KEYS = ("computed_N", "asce7", "haehnel_daly", "eurocode_bar", "matsutomi")
-NAMES = {"computed_N": "computed (flexcontact)", "asce7": "ASCE 7 / FEMA P-55",
+KEYS = (("computed_N",) + (() if args.no_crushing else ("computed_crushing_N",))
+        + ("asce7", "haehnel_daly", "eurocode_bar", "matsutomi"))
+NAMES = {"computed_N": "model, elastic end", "computed_crushing_N": "model, flat end crushing",
+         "asce7": "ASCE 7 / FEMA P-55",
          "haehnel_daly": "Haehnel & Daly", "eurocode_bar": "EN 1991-1-7 bar (EA/L)",
          "matsutomi": "Matsutomi"}
 if comm.rank == 0:
@@ -112,13 +150,19 @@ if comm.rank == 0:
         w.writeheader()
         w.writerows(rows)
     unit = "N" if args.dim == 3 else "N (2D per metre × log diameter)"
-    lines = [f"Peak impact force [MN]; {args.dim}D model, forces in {unit}.", "",
-             "| L [m] | m [kg] | v [m/s] | " + " | ".join(NAMES[k] for k in KEYS)
-             + " | contact [ms] | k_eff [MN/m] |", "|---" * (5 + len(KEYS)) + "|"]
+    k_heads = " | k_eff elastic [MN/m]" + ("" if args.no_crushing
+                                          else " | k_eff crushing [MN/m]")
+    lines = [f"Peak impact force [MN]; {args.dim}D model, forces in {unit}; the model's "
+             "columns are filtered peaks (moving average over a tenth of the log's 2L/c).",
+             "", "| L [m] | m [kg] | v [m/s] | " + " | ".join(NAMES[k] for k in KEYS)
+             + " | contact [ms]" + k_heads + " |",
+             "|---" * (4 + len(KEYS) + (1 if args.no_crushing else 2)) + "|"]
     for r in rows:
+        k_vals = f" | {r['k_effective_N_m'] / 1e6:.1f}" + (
+            "" if args.no_crushing else f" | {r['k_effective_crushing_N_m'] / 1e6:.1f}")
         lines.append(f"| {r['length_m']:g} | {r['mass_kg']:.0f} | {r['speed_m_s']:g} | "
                      + " | ".join(f"{r[k] / 1e6:.3f}" for k in KEYS)
-                     + f" | {r['contact_s'] * 1e3:.2f} | {r['k_effective_N_m'] / 1e6:.0f} |")
+                     + f" | {r['contact_s'] * 1e3:.2f}{k_vals} |")
     (folder / "comparison.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     if not args.no_plot:
@@ -130,8 +174,9 @@ if comm.rank == 0:
             sel = [r for r in rows if r["length_m"] == length]
             v = [r["speed_m_s"] for r in sel]
             for k in KEYS:
-                ax.plot(v, [r[k] / 1e6 for r in sel], "o-" if k == "computed_N" else ".--",
-                        label=NAMES[k], lw=2 if k == "computed_N" else 1)
+                model = k.startswith("computed")
+                ax.plot(v, [r[k] / 1e6 for r in sel], "o-" if model else ".--",
+                        label=NAMES[k], lw=2 if model else 1)
             ax.set_yscale("log")
             ax.set_xlabel("log speed [m/s]")
             ax.set_ylabel("peak force [MN]")
