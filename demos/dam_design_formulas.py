@@ -19,9 +19,10 @@
 # in the table.
 #
 # Run: `/usr/bin/python3 demos/dam_design_formulas.py [--speeds 1 2 4] [--lengths 5 10]
-# [--dim 3] [--no-crushing]`; about a minute per elastic run of the 3D coarse mesh here, two
-# to three per crushing run. Results in `results/dam_design_formulas/` (CSV, markdown
-# table, PNG, summary.json).
+# [--dim 3] [--no-crushing]`; about a minute per elastic run of the 3D coarse mesh here,
+# several per crushing run (the first length and speed, both meshes and runs, took 9 minutes);
+# `--dim 2` takes about a minute in all. Results in `results/dam_design_formulas/` (CSV,
+# markdown table, PNG, summary.json).
 
 # %%
 import argparse
