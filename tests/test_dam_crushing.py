@@ -85,16 +85,15 @@ def test_crushing_strength_is_a_sweep_input(tmp_path):
 def test_the_contact_ball_refines_the_first_contact_point():
     """mesh_size_contact_m: elements of about that size within contact_zone_m of the first
     contact point (2D), the rest of the mesh as without it."""
+    from flexcontact import compat
     from flexcontact.meshes import dam as dam_mesh
     coarse = DamScenario()
     fine = coarse.replace(mesh_size_contact_m=0.0125, contact_zone_m=0.1)
     sizes = {}
     for name, s in (("coarse", coarse), ("fine", fine)):
-        mesh = dam_mesh.build(COMM, s)
-        msh = mesh.msh if hasattr(mesh, "msh") else mesh[0]
-        x = msh.geometry.x[:, :2]
-        cells = msh.geometry.dofmap
-        cells = cells.array.reshape(-1, 3) if hasattr(cells, "array") else np.asarray(cells)
+        msh = dam_mesh.build(COMM, s)[0]
+        x = compat.geometry_x(msh)[:, :2]
+        cells = compat.geometry_dofmap(msh)
         centre = np.asarray(s.log_front_point)
         # The cells with a vertex within 3 cm of the corner (a vertex of the log's mesh).
         near = (np.linalg.norm(x[cells] - centre, axis=2) <= 0.03).any(axis=1)
