@@ -44,6 +44,15 @@ inline Vector carried_force(const std::vector<ContactPair>& old_pairs, const Vec
   return lambda;
 }
 
+/// @brief A value kept per contact node (a crush depth) read for each pair at its slave.
+inline Vector at_slaves(const std::vector<ContactPair>& pairs, const Vector& node_values)
+{
+  Vector v(static_cast<Eigen::Index>(pairs.size()));
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    v[static_cast<Eigen::Index>(k)] = node_values[pairs[k].slave];
+  return v;
+}
+
 /// @brief States of the new pairs: the slave node's old state, open for a new one.
 inline std::vector<PairState> carried_states(const std::vector<PairState>& old_states,
                                              const std::vector<int>& previous)

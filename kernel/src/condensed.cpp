@@ -53,10 +53,7 @@ void CondensedContact::set_crushing(Vector cap)
     solver_.set_crushing(Vector(), Vector());
     return;
   }
-  Vector depth(pairs());
-  for (int k = 0; k < pairs(); ++k)
-    depth[k] = crush_node_[pairs_[static_cast<std::size_t>(k)].slave];
-  solver_.set_crushing(cap, depth); // checks sizes and values
+  solver_.set_crushing(cap, detail::at_slaves(pairs_, crush_node_)); // checks sizes, values
   cap_ = std::move(cap);
 }
 
@@ -97,12 +94,7 @@ void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vect
   if (R_.cols())
     solver.set_border(B * R_);
   if (cap.size())
-  {
-    Vector depth(cap.size());
-    for (std::size_t k = 0; k < pairs.size(); ++k)
-      depth[static_cast<Eigen::Index>(k)] = crush_node_[pairs[k].slave];
-    solver.set_crushing(cap, depth);
-  }
+    solver.set_crushing(cap, detail::at_slaves(pairs, crush_node_));
   B_ = std::move(B);
   x0_ = std::move(x0);
   solver_ = std::move(solver);
