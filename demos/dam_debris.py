@@ -7,12 +7,14 @@
 # pressure on the upstream face (optionally tailwater and uplift); then **stage 2**, the
 # log's impact on the upstream face, starting from this state (`--stage1-only` skips it).
 #
-# By default the dam is a plane-strain section (per metre of dam: a raft of logs abreast
-# along the whole crest, not one log); `--dim 3` runs a 3D block between contraction joints
-# (15 m wide) with a round, flat-ended log. The log's end is elastic (the upper bound of the
-# force) unless `--log-end-crushes`: then it crushes at the wood's crushing strength
-# (docs/crushing.md), and the mesh is refined about the first-contact point so that the
-# crushed patch at the peak force spans at least four elements (CRUSHED_PATCH_MESH).
+# By default the dam is a 3D block between contraction joints (15 m wide, `--dam-width`) on
+# its foundation, and the log a round one, pitched 10° (`--log-pitch`, `--log-yaw`), whose
+# front end crushes at the wood's crushing strength (docs/crushing.md); the mesh is refined
+# about the first-contact point so that the crushed patch at the peak force spans at least
+# four elements (CRUSHED_PATCH_MESH). `--elastic-end` keeps the end elastic (the upper bound
+# of the force); `--log-end` shapes it (flat, chamfered, rounded). `--dim 2` runs the
+# plane-strain section instead: per metre of dam, a raft of logs abreast along the whole
+# crest, not one log.
 #
 # What is measured: the base section's normal force N, shear and moment M from the nodal
 # forces the dam hands to the foundation, against the hand statics of the dam's free body
@@ -20,8 +22,8 @@
 # statics, so they agree to round-off. From them, the linearised heel and toe stresses
 # σ = −N/B ± 6M/B² that dam engineers use (per metre of dam in 2D).
 #
-# Run: `/usr/bin/python3 demos/dam_debris.py [--dim 3] [--refine N] [--water-level 27]
-# [--log-end-crushes] [--stage1-only] [--mesh-study]`;
+# Run: `/usr/bin/python3 demos/dam_debris.py [--dim 2] [--refine N] [--water-level 27]
+# [--log-end flat|chamfered|rounded] [--elastic-end] [--stage1-only] [--mesh-study]`;
 # results go to `results/dam_debris/`, with a short report `report.md`.
 
 # %%
@@ -42,7 +44,10 @@ from flexcontact.meshes import dam_tags
 
 parser = argparse.ArgumentParser(description="floating log and gravity dam: statics and impact")
 parser.add_argument("--refine", type=int, default=0, help="halve the element sizes N times")
-parser.add_argument("--dim", type=int, default=2, choices=(2, 3))
+parser.add_argument("--dim", type=int, default=3, choices=(2, 3),
+                    help="3: a dam block and a round log (default); 2: the plane-strain section")
+parser.add_argument("--dam-width", type=float, default=15.0,
+                    help="3D block width between contraction joints, m")
 parser.add_argument("--water-level", type=float, default=27.0, help="m above the base")
 parser.add_argument("--tailwater", type=float, default=0.0, help="m above the base")
 parser.add_argument("--uplift", type=float, default=0.0, help="uplift factor, 0 to 1")
@@ -55,12 +60,19 @@ parser.add_argument("--westergaard", action="store_true",
                     help="stage 2: the reservoir's added mass on the upstream face (Westergaard)")
 parser.add_argument("--gap", type=float, default=0.02, help="log to face, m")
 parser.add_argument("--mu", type=float, default=0.5, help="friction coefficient (stage 2)")
-parser.add_argument("--log-end-crushes", action="store_true",
-                    help="the log's front end crushes at the wood's crushing strength")
+parser.add_argument("--log-end", default="flat", choices=("flat", "chamfered", "rounded"),
+                    help="the log's front end: sawn flat, chamfered, or a spherical cap")
+parser.add_argument("--end-chamfer", type=float, default=None,
+                    help="chamfer c of a chamfered end, m (0 < c < D/2; default D/8)")
+parser.add_argument("--end-radius", type=float, default=None,
+                    help="sphere radius of a rounded end, m (>= D/2, a hemisphere; default D)")
+parser.add_argument("--elastic-end", action="store_true",
+                    help="the log's front end stays elastic (the upper bound of the force); "
+                         "default: it crushes at the wood's crushing strength")
 parser.add_argument("--contact-size", type=float, default=None,
                     help="element size (m) within --contact-zone of the first-contact point "
-                         "(default with --log-end-crushes: CRUSHED_PATCH_MESH of the "
-                         "dimension; without: the impact zone's)")
+                         "(default: CRUSHED_PATCH_MESH of the dimension; with --elastic-end: "
+                         "the impact zone's)")
 parser.add_argument("--contact-zone", type=float, default=None,
                     help="radius (m) of the refined ball about the first-contact point")
 parser.add_argument("--offset", type=float, default=1.0,
@@ -91,13 +103,17 @@ t_start = time.perf_counter()
 
 # %%
 from flexcontact.dam.scenario import CRUSHED_PATCH_MESH
-size, zone = CRUSHED_PATCH_MESH[args.dim] if args.log_end_crushes else (None, 0.1)
+crushes = not args.elastic_end
+size, zone = CRUSHED_PATCH_MESH[args.dim] if crushes else (None, 0.1)
 scenario = DamScenario(
-    dim=args.dim, refine=args.refine, water_level_m=args.water_level,
+    dim=args.dim, dam_width_m=args.dam_width, refine=args.refine,
+    water_level_m=args.water_level,
     tailwater_level_m=args.tailwater, uplift_factor=args.uplift,
     log_speed_m_s=args.log_speed, log_pitch_deg=args.log_pitch, log_yaw_deg=args.log_yaw,
     log_length_m=args.log_length, log_diameter_m=args.log_diameter, log_gap_m=args.gap,
-    friction_mu=args.mu, westergaard=args.westergaard, log_end_crushes=args.log_end_crushes,
+    friction_mu=args.mu, westergaard=args.westergaard, log_end_crushes=crushes,
+    log_end_shape=args.log_end, log_end_chamfer_m=args.end_chamfer,
+    log_end_radius_m=args.end_radius,
     mesh_size_contact_m=args.contact_size or size, contact_zone_m=args.contact_zone or zone)
 folder = fc.results_folder("dam_debris")
 
@@ -258,23 +274,24 @@ if not args.stage1_only:
 
 # %% [markdown]
 # ## ParaView picture
-# The dam at the step of the peak contact force, warped so that its displacement shows
-# (scale: the dam's largest displacement drawn as 5 % of its height), coloured by the largest
-# principal stress (red: tension) on ±2 × the concrete's tensile strength (saturated beyond). Rendered by `pvbatch` under `xvfb-run` if ParaView is
-# installed; otherwise the report says so.
+# The dam and the log at the step of the peak contact force, as they are (displacements
+# true to scale: the log touches the face), coloured by the largest principal stress (red:
+# tension; the log is in compression) on ±2 × the concrete's tensile strength (saturated
+# beyond). Rendered by `pvbatch` under `xvfb-run` if ParaView is installed; otherwise the
+# report says so.
 
 # %%
 paraview = (False, "skipped (--no-paraview)") if args.no_paraview else None
 if not args.stage1_only and not args.no_paraview:
-    from flexcontact.dam.picture import render_stress_picture, warp_scale
+    from flexcontact.dam.picture import render_stress_picture
     paraview = (False, "not rendered")
-    scale = warp_scale(peak_u, cells, dam_tags.DAM, s.dam_height_m)
     if comm.rank == 0:
         # Saturated at twice the concrete's tensile strength: the contact point's singular
-        # peak would otherwise wash out the dam's stress field.
+        # peak would otherwise wash out the dam's stress field. Not warped: an exaggerated
+        # dam would move its face through the log.
         paraview = render_stress_picture(folder / "impact_peak.xdmf",
-                                         folder / "stress_paraview.png", scale,
-                                         body_tag=dam_tags.DAM,
+                                         folder / "stress_paraview.png", 1.0,
+                                         body_tag=(dam_tags.DAM, dam_tags.LOG),
                                          bound=2.0 * s.concrete_tensile_strength_Pa)
         print(("ParaView picture: " if paraview[0] else "no ParaView picture: ") + paraview[1])
     paraview = comm.bcast(paraview, root=0)

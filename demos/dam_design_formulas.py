@@ -8,10 +8,11 @@
 # Haehnel & Daly (F = v √(k m), k = 2.4 MN/m), EN 1991-1-7 Annex C with the log as an
 # elastic bar (k = EA/L) and Matsutomi's driftwood fit. See docs/dam.md for why they differ.
 #
-# Two model columns: the log's end elastic (the upper bound of the force), and the log's
-# flat end crushing at the wood's crushing strength (docs/crushing.md) on a mesh that
-# resolves the crushed patch (`scenario.CRUSHED_PATCH_MESH`). Both are the filtered peak
-# force (a centred moving average over a tenth of the log's 2L/c, docs/impact.md).
+# The model's columns: the log's flat end elastic (the upper bound of the force), and its
+# end crushing at the wood's crushing strength (docs/crushing.md), flat and rounded (a
+# spherical cap of radius D; `--crushing-ends`), on a mesh that resolves the crushed patch
+# (`scenario.CRUSHED_PATCH_MESH`). All are the filtered peak force (a centred moving
+# average over a tenth of the log's 2L/c, docs/impact.md).
 # Elastic, the model is linear in the speed; crushing, it is not, so each speed is a run.
 #
 # With `--dim 2` the plane-strain section is used instead and its force per metre is
@@ -45,7 +46,10 @@ parser.add_argument("--lengths", type=float, nargs="+", default=[5.0, 10.0],
                     help="log lengths, m (the mass follows)")
 parser.add_argument("--refine", type=int, default=0)
 parser.add_argument("--no-crushing", action="store_true",
-                    help="skip the crushing-end column (elastic end only)")
+                    help="skip the crushing-end columns (elastic end only)")
+parser.add_argument("--crushing-ends", nargs="+", default=["flat", "rounded"],
+                    choices=("flat", "chamfered", "rounded"),
+                    help="end shapes of the crushing columns (the rounded cap's radius is D)")
 parser.add_argument("--no-plot", action="store_true")
 args = parser.parse_args()
 comm = MPI.COMM_WORLD
@@ -91,13 +95,13 @@ for length in args.lengths:
     base = DamScenario(dim=args.dim, refine=args.refine, log_length_m=length)
     stage1 = solve_stage1(base, comm=comm)
     gap = max(mesh_gap_m(stage1), base.log_gap_m)
-    crushing = None
-    if not args.no_crushing:
+    crushing = {}  # end shape -> (scenario, stage 1, mesh gap)
+    for end in ([] if args.no_crushing else args.crushing_ends):
         size, zone = CRUSHED_PATCH_MESH[args.dim]
-        crushing = base.replace(log_end_crushes=True, mesh_size_contact_m=size,
-                                contact_zone_m=zone)
-        stage1_c = solve_stage1(crushing, comm=comm)
-        gap_c = max(mesh_gap_m(stage1_c), crushing.log_gap_m)
+        sc = base.replace(log_end_crushes=True, log_end_shape=end, mesh_size_contact_m=size,
+                          contact_zone_m=zone)
+        st1 = solve_stage1(sc, comm=comm)
+        crushing[end] = (sc, st1, max(mesh_gap_m(st1), sc.log_gap_m))
     for v in args.speeds:
         s = base.replace(log_speed_m_s=v)
         r, duration = impact(s, stage1, gap)
@@ -111,14 +115,15 @@ for length in args.lengths:
                "episodes": r.metrics["episodes"], "mesh_gap_m": gap,
                "contact_ended": bool(r.metrics["contact_end_s"] is not None
                                      and r.metrics["contact_end_s"] < duration - 1e-12)}
-        if crushing is not None:
-            rc, _ = impact(crushing.replace(log_speed_m_s=v), stage1_c, gap_c)
+        for end, (sc, st1, gap_c) in crushing.items():
+            rc, _ = impact(sc.replace(log_speed_m_s=v), st1, gap_c)
             Fc = rc.metrics["peak_force_filtered"] * width
-            row.update(computed_crushing_N=Fc,
-                       crush_depth_m=max((x.crush_depth_max_m for x in rc.problem.records),
-                                         default=0.0),
-                       k_effective_crushing_N_m=Fc * Fc
-                       / (m * (1 + s.added_mass_coefficient) * v * v))
+            mc = sc.log_mass_kg()
+            row.update({f"computed_crushing_{end}_N": Fc,
+                        f"crush_depth_{end}_m": max((x.crush_depth_max_m
+                                                     for x in rc.problem.records), default=0.0),
+                        f"k_effective_crushing_{end}_N_m": Fc * Fc
+                        / (mc * (1 + s.added_mass_coefficient) * v * v)})
         row.update({k: f for k, f in dfm.all_formulas_N(
             m, v, s.log_diameter_m, length, s.wood.E_Pa, s.wood.rho_kg_m3,
             s.wood_crushing_strength_Pa).items()})
@@ -126,8 +131,9 @@ for length in args.lengths:
         row["k_effective_N_m"] = F * F / (m * (1 + s.added_mass_coefficient) * v * v)
         rows.append(row)
         if comm.rank == 0:
-            crushed = (f", crushing end {row['computed_crushing_N'] / 1e6:.3f} MN"
-                       if crushing is not None else "")
+            crushed = "".join(f", crushing {end} end "
+                              f"{row[f'computed_crushing_{end}_N'] / 1e6:.3f} MN"
+                              for end in crushing)
             print(f"L = {length:g} m (m = {m:.0f} kg), v = {v:g} m/s: computed "
                   f"{F / 1e6:.3f} MN elastic{crushed}; ASCE 7 {row['asce7'] / 1e6:.3f}, Haehnel & Daly "
                   f"{row['haehnel_daly'] / 1e6:.3f}, EN 1991-1-7 bar "
@@ -138,9 +144,11 @@ for length in args.lengths:
 # ## The table and the plot
 
 # %%
-KEYS = (("computed_N",) + (() if args.no_crushing else ("computed_crushing_N",))
+ENDS = [] if args.no_crushing else list(args.crushing_ends)
+KEYS = (("computed_N",) + tuple(f"computed_crushing_{e}_N" for e in ENDS)
         + ("asce7", "haehnel_daly", "eurocode_bar", "matsutomi"))
-NAMES = {"computed_N": "model, elastic end", "computed_crushing_N": "model, flat end crushing",
+NAMES = {"computed_N": "model, elastic flat end",
+         **{f"computed_crushing_{e}_N": f"model, {e} end crushing" for e in ENDS},
          "asce7": "ASCE 7 / FEMA P-55",
          "haehnel_daly": "Haehnel & Daly", "eurocode_bar": "EN 1991-1-7 bar (EA/L)",
          "matsutomi": "Matsutomi"}
@@ -151,16 +159,16 @@ if comm.rank == 0:
         w.writeheader()
         w.writerows(rows)
     unit = "N" if args.dim == 3 else "N (2D per metre × log diameter)"
-    k_heads = " | k_eff elastic [MN/m]" + ("" if args.no_crushing
-                                          else " | k_eff crushing [MN/m]")
+    k_heads = " | k_eff elastic [MN/m]" + "".join(f" | k_eff {e} crushing [MN/m]"
+                                                  for e in ENDS)
     lines = [f"Peak impact force [MN]; {args.dim}D model, forces in {unit}; the model's "
              "columns are filtered peaks (moving average over a tenth of the log's 2L/c).",
              "", "| L [m] | m [kg] | v [m/s] | " + " | ".join(NAMES[k] for k in KEYS)
              + " | contact [ms]" + k_heads + " |",
-             "|---" * (4 + len(KEYS) + (1 if args.no_crushing else 2)) + "|"]
+             "|---" * (5 + len(KEYS) + len(ENDS)) + "|"]
     for r in rows:
-        k_vals = f" | {r['k_effective_N_m'] / 1e6:.1f}" + (
-            "" if args.no_crushing else f" | {r['k_effective_crushing_N_m'] / 1e6:.1f}")
+        k_vals = f" | {r['k_effective_N_m'] / 1e6:.1f}" + "".join(
+            f" | {r[f'k_effective_crushing_{e}_N_m'] / 1e6:.1f}" for e in ENDS)
         lines.append(f"| {r['length_m']:g} | {r['mass_kg']:.0f} | {r['speed_m_s']:g} | "
                      + " | ".join(f"{r[k] / 1e6:.3f}" for k in KEYS)
                      + f" | {r['contact_s'] * 1e3:.2f}{k_vals} |")

@@ -23,6 +23,7 @@ from .dam_tags import (DAM, DAM_BASE, DAM_CREST, DAM_DOWNSTREAM, DAM_FLANKS, DAM
                        FOUNDATION, FOUNDATION_BOTTOM, FOUNDATION_FLANKS, FOUNDATION_SIDES, LOG,
                        LOG_BACK, LOG_FRONT, LOG_LOWER, LOG_MANTLE, LOG_UPPER, NAMES,
                        RESERVOIR_BED, TAILWATER_BED)
+from .log_end import LogEnd
 from flexcontact.errors import InputError
 
 
@@ -135,16 +136,53 @@ def _foundation_2d(s, geo, heel, toe, base):
 
 
 def _log_2d(s, geo):
-    """The log's rectangle: corners back-lower, front-lower, front-upper, back-upper."""
+    """The log's outline: the shaft's lower and upper edges, its back end and the front end
+    shaped by ``s.log_end``."""
     a = s.log_axis
     n = np.array([-a[1], a[0]])
-    c, hl, r = s.log_centre, 0.5 * s.log_length_m, s.log_radius_m
-    corners = [c - hl * a - r * n, c + hl * a - r * n, c + hl * a + r * n, c - hl * a + r * n]
-    q = [geo.addPoint(float(x), float(y), 0) for x, y in corners]
-    lower, front = geo.addLine(q[0], q[1]), geo.addLine(q[1], q[2])
-    upper, back = geo.addLine(q[2], q[3]), geo.addLine(q[3], q[0])
-    surface = geo.addPlaneSurface([geo.addCurveLoop([lower, front, upper, back])])
-    return ({LOG_LOWER: [lower], LOG_FRONT: [front], LOG_UPPER: [upper], LOG_BACK: [back]},
+    c = s.log_centre
+    return log_outline_2d(geo, s.log_length_m, s.log_radius_m, s.log_end,
+                          lambda x, y: c + x * a + y * n)
+
+
+def log_outline_2d(geo, length_m, radius_m, end, to_world):
+    """Add the 2D log's curves and surface to gmsh's ``geo`` kernel, with the log-frame
+    point (x along the axis, y across it) placed at ``to_world(x, y)``. Returns
+    ({tag: curves}, surface). The front end (tag ``log_front``) is every curve beyond the
+    shaft: a segment (flat), three segments (chamfered), or two arcs meeting on the axis
+    (rounded; two, because a gmsh arc must be shorter than half a circle)."""
+    h, R = 0.5 * length_m, radius_m
+    d = end.depth_m(R)
+
+    def point(x, y):
+        X = to_world(x, y)
+        return geo.addPoint(float(X[0]), float(X[1]), 0)
+
+    # Points and curves in the order back-lower, front end, back-upper: a flat log's
+    # entities are numbered as they always were, so its mesh is unchanged.
+    back_low = point(-h, -R)
+    if end.shape == "flat":
+        front_low, front_up = point(h, -R), point(h, R)
+        ends = [(front_low, front_up)]
+    elif end.shape == "chamfered":
+        cc = float(end.chamfer_m)
+        front_low, q1, q2 = point(h - cc, -R), point(h, -R + cc), point(h, R - cc)
+        front_up = point(h - cc, R)
+        ends = [(front_low, q1), (q1, q2), (q2, front_up)]
+    else:
+        x_c = end.cap(length_m, R)[0]
+        front_low, centre, pole = point(h - d, -R), point(x_c, 0.0), point(h, 0.0)
+        front_up = point(h - d, R)
+    back_up = point(-h, R)
+    lower = geo.addLine(back_low, front_low)
+    if end.shape == "rounded":
+        front = [geo.addCircleArc(front_low, centre, pole),
+                 geo.addCircleArc(pole, centre, front_up)]
+    else:
+        front = [geo.addLine(p, q) for p, q in ends]
+    upper, back = geo.addLine(front_up, back_up), geo.addLine(back_up, back_low)
+    surface = geo.addPlaneSurface([geo.addCurveLoop([lower, *front, upper, back])])
+    return ({LOG_LOWER: [lower], LOG_FRONT: front, LOG_UPPER: [upper], LOG_BACK: [back]},
             surface)
 
 
@@ -178,9 +216,38 @@ def _model_3d(s, info):
 
 
 def _log_3d(s, occ):
-    a, L = s.log_axis, s.log_length_m
-    back = s.log_centre - 0.5 * L * a
-    return occ.addCylinder(*map(float, back), *map(float, L * a), s.log_radius_m)
+    """The log's solid: a cylinder, or its shaped profile revolved about the axis (OCC's
+    Boolean fuse of a cylinder and a spherical cap leaves a face it cannot mesh)."""
+    a, L, R, end = s.log_axis, s.log_length_m, s.log_radius_m, s.log_end
+    if end.shape == "flat":
+        back = s.log_centre - 0.5 * L * a
+        return occ.addCylinder(*map(float, back), *map(float, L * a), R)
+    n = np.cross(a, [0.0, 1.0, 0.0] if abs(a[1]) < 0.9 else [1.0, 0.0, 0.0])
+    n /= np.linalg.norm(n)
+    c, h, d = s.log_centre, 0.5 * L, end.depth_m(R)
+
+    def point(x, y):
+        return occ.addPoint(*map(float, c + x * a + y * n))
+
+    axis_back, rim_back, rim_front = point(-h, 0.0), point(-h, R), point(h - d, R)
+    axis_front = point(h, 0.0)
+    if end.shape == "chamfered":
+        corner = point(h, R - float(end.chamfer_m))
+        tip = [occ.addLine(rim_front, corner), occ.addLine(corner, axis_front)]
+    else:
+        centre = point(end.cap(L, R)[0], 0.0)
+        tip = [occ.addCircleArc(rim_front, centre, axis_front)]
+        occ.remove([(0, centre)])
+    loop = [occ.addLine(axis_back, rim_back), occ.addLine(rim_back, rim_front), *tip,
+            occ.addLine(axis_front, axis_back)]
+    profile = occ.addPlaneSurface([occ.addCurveLoop(loop)])
+    solids = [t for dim, t in occ.revolve([(2, profile)], *map(float, c), *map(float, a),
+                                          2.0 * np.pi) if dim == 3]
+    occ.remove([(2, profile)])  # the profile is no face of the solid of revolution
+    if len(solids) != 1:
+        raise InputError(f"log_end_shape={end.shape!r}: gmsh made {len(solids)} solids of "
+                         f"the log's profile, not one")
+    return solids[0]
 
 
 def _faces_3d(s, dam, found, log_vol):
@@ -206,15 +273,14 @@ def _faces_3d(s, dam, found, log_vol):
                                                            oriented=False)}
     out[DAM_DOWNSTREAM] = sorted(dam_faces - taken)
     log_faces = [abs(t) for _, t in gmsh.model.getBoundary([(3, log_vol)], oriented=False)]
-    ends = {}
-    front = s.log_centre + 0.5 * s.log_length_m * s.log_axis
-    for f in log_faces:
-        com = np.array(gmsh.model.occ.getCenterOfMass(2, f))
-        ends[f] = np.linalg.norm(com - front)
-    flat = sorted(log_faces, key=lambda f: gmsh.model.getType(2, f) != "Plane")[:2]
-    out[LOG_FRONT] = [min(flat, key=ends.get)]
-    out[LOG_BACK] = [max(flat, key=ends.get)]
-    out[LOG_MANTLE] = sorted(set(log_faces) - set(flat))
+    # Each face by its centroid's axial position: the back disc at -L/2, the shaft's mantle
+    # at -d/2, every face of the front end beyond the shaft's end L/2 - d.
+    L, d = s.log_length_m, s.log_end.depth_m(s.log_radius_m)
+    axial = {f: float((np.array(gmsh.model.occ.getCenterOfMass(2, f)) - s.log_centre)
+                      @ s.log_axis) for f in log_faces}
+    out[LOG_BACK] = [min(log_faces, key=axial.get)]
+    out[LOG_FRONT] = sorted(f for f in log_faces if axial[f] >= 0.5 * L - d - 1e-9 * L)
+    out[LOG_MANTLE] = sorted(set(log_faces) - set(out[LOG_BACK]) - set(out[LOG_FRONT]))
     return out
 
 
@@ -277,31 +343,29 @@ def _model_dam_only_2d(s, info, face_levels):
     return info
 
 
-def build_log(comm, length_m, diameter_m, h_m):
+def build_log(comm, length_m, diameter_m, h_m, end=None):
     """The 2D log (a plane-strain slab ``length_m`` × ``diameter_m``) in its own frame: axis
-    along x, centre at the origin, front end (tag ``log_front``) at x = +L/2; elements of
-    size ``h_m``. Tags: cells ``log``; facets ``log_front``, ``log_back``, ``log_upper``,
-    ``log_lower``. Returns (mesh, cell_tags, facet_tags, info)."""
+    along x, centre at the origin, front end (tag ``log_front``) at x = +L/2, shaped by
+    ``end`` (a :class:`~.log_end.LogEnd`; None: flat); elements of size ``h_m``. Tags:
+    cells ``log``; facets ``log_front``, ``log_back``, ``log_upper``, ``log_lower``.
+    Returns (mesh, cell_tags, facet_tags, info)."""
     from ._check import positive
     L, D, h = (positive(n, v) for n, v in (("length_m", length_m), ("diameter_m", diameter_m),
                                            ("h_m", h_m)))
-    info = dict(dim=2, length_m=L, diameter_m=D, h_m=h)
-    return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, info), gdim=2)
+    end = (LogEnd() if end is None else end).check(D, ("end.shape", "end.chamfer_m",
+                                                       "end.radius_m"))
+    info = dict(dim=2, length_m=L, diameter_m=D, h_m=h, end_shape=end.shape)
+    return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, end, info), gdim=2)
 
 
-def _model_log_2d(L, D, h, info):
+def _model_log_2d(L, D, h, end, info):
     import gmsh
     geo = gmsh.model.geo
-    corners = [(-L / 2, -D / 2), (L / 2, -D / 2), (L / 2, D / 2), (-L / 2, D / 2)]
-    q = [geo.addPoint(x, y, 0) for x, y in corners]
-    lower, front = geo.addLine(q[0], q[1]), geo.addLine(q[1], q[2])
-    upper, back = geo.addLine(q[2], q[3]), geo.addLine(q[3], q[0])
-    surface = geo.addPlaneSurface([geo.addCurveLoop([lower, front, upper, back])])
+    curves, surface = log_outline_2d(geo, L, 0.5 * D, end, lambda x, y: (x, y))
     geo.synchronize()
     _gmsh.physical(2, [surface], LOG, NAMES[LOG])
-    for tag, c in ((LOG_LOWER, lower), (LOG_FRONT, front), (LOG_UPPER, upper),
-                   (LOG_BACK, back)):
-        _gmsh.physical(1, [c], tag, NAMES[tag])
+    for tag in (LOG_LOWER, LOG_FRONT, LOG_UPPER, LOG_BACK):
+        _gmsh.physical(1, curves[tag], tag, NAMES[tag])
     gmsh.option.setNumber("Mesh.MeshSizeMin", h)
     gmsh.option.setNumber("Mesh.MeshSizeMax", h)
     try:

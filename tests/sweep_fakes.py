@@ -74,3 +74,17 @@ class CheckedLinearEvaluator(LinearEvaluator):
 
 def sweep_time_step_s(scenarios):
     return 1e-4
+
+
+END_FACTOR = {"flat": 1.0, "chamfered": 0.8, "rounded": 0.5}
+"""The peak force of :class:`EndShapeEvaluator`, relative to the flat end's."""
+
+
+class EndShapeEvaluator(LinearEvaluator):
+    """:class:`LinearEvaluator` whose peak force scales with the log's end shape
+    (:data:`END_FACTOR`): a categorical input with a known effect."""
+
+    def evaluate(self, s) -> dict:
+        out = super().evaluate(s)
+        out["peak_force_N_per_m"] *= END_FACTOR[s.log_end_shape]
+        return out

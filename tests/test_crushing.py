@@ -192,3 +192,35 @@ def test_crushing_bar_two_ranks_equal_serial(tmp_path):
     assert two["force"].shape == serial["force"].shape
     assert np.abs(two["force"] - serial["force"]).max() <= 1e-10 * scale
     assert two["depth"][-1] == pytest.approx(serial["depth"][-1], rel=1e-10)
+
+
+def test_crushing_at_the_zone_edge_warns():
+    """A rigid circle pressed into a block whose candidate zone is narrower than the
+    crushed patch: the pairs at the zone's open edge crush (state crush), and the interface
+    warns as contact there does (ContactZoneWarning, the increment kept)."""
+    import warnings
+
+    from demo_runner import A_TARGET, R_HERTZ
+    from flexcontact.meshes import hertz2d
+    from flexcontact.states import CRUSH
+    steel = forms.Material(E_Pa=200e9, nu=0.3, name="steel")
+    msh, _, facets, geo = hertz2d.build(MPI.COMM_WORLD, R=R_HERTZ, a_expected=A_TARGET,
+                                        zone_factor=1.0, with_cylinder=False)
+    V = compat.vector_space(msh)
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    a = forms.elasticity_form(u, v, steel, ufl.dx(domain=msh), "plane_strain")
+    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
+    circle = fc.RigidTarget("circle", point_m=(0.0, R_HERTZ), radius_m=R_HERTZ)
+    # σ_c far below the Hertz pressure: the whole zone crushes at a modest approach.
+    problem = fc.ContactProblem(a, None, fixed, fc.ContactInterface(
+        facets, tags.MASTER, circle, 0.0, name="crushable", crushing_strength_Pa=1e6))
+    w = geo["w"]
+    circle.displacement_m = np.array([0.0, -(1.5 * w) ** 2 / R_HERTZ])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", fc.ContactZoneWarning)
+        inc = problem.step()
+    assert inc.summary.zone_edge == ["crushable"]
+    assert (inc.states == CRUSH).sum() == len(inc.states)
+    if MPI.COMM_WORLD.rank == 0:
+        assert any(issubclass(c.category, fc.ContactZoneWarning)
+                   and "crushable: increment 1" in str(c.message) for c in caught)

@@ -431,3 +431,69 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     s = sweep.run(sweep.from_dict(raw), out=tmp_path / "out")
     assert s["scenarios"] == 16
     assert s["counts"]["factorizations"]["total"] == 3, s["counts"]
+
+
+# ---- a categorical input: the log's end shape ---------------------------------------------
+
+def shape_config(n=30, method="lhs"):
+    raw = fake_config(n=n, seed=9, method=method)
+    raw["parameters"] = {"log_speed_m_s": {"distribution": "uniform", "lo": 0.5, "hi": 4.0},
+                         "log_end_shape": {"values": ["flat", "chamfered", "rounded"]}}
+    raw["engine"]["evaluator"] = "sweep_fakes:EndShapeEvaluator"
+    return raw
+
+
+def test_end_shape_is_sampled_uniformly_and_reported_per_name(tmp_path):
+    """LHS gives each of the 3 names n/3 scenarios; the report has no rank correlation for
+    the name but, per name, its count, median, largest value and the share above the
+    median and the 10 % value of all, exactly as from the fake's outputs."""
+    n = 30
+    cfg = sweep.from_dict(shape_config(n))
+    _, points, scenarios = build_scenarios(cfg)
+    shapes = [p["log_end_shape"] for p in points]
+    assert all(shapes.count(x) == n // 3 for x in sweep_fakes.END_FACTOR)
+    assert [s.log_end_shape for s in scenarios] == shapes
+    summary = sweep.run(sweep.from_dict(shape_config(n) | {"output": {"plots": True,
+                                                                    "bootstrap": 50}}),
+                        out=tmp_path / "out")
+    force = np.array([1e6 * p["log_speed_m_s"] * sweep_fakes.END_FACTOR[p["log_end_shape"]]
+                      for p in points])
+    assert set(summary["spearman"]["peak_force_N_per_m"]) == {"log_speed_m_s"}
+    x50, x10 = np.quantile(force, [0.5, 0.9])
+    table = summary["by_category"]["log_end_shape"]["peak_force_N_per_m"]
+    for name in sweep_fakes.END_FACTOR:
+        f = force[[s == name for s in shapes]]
+        assert table[name] == {"n": n // 3, "median": float(np.median(f)),
+                               "max": float(f.max()),
+                               "p_over_median": float(np.mean(f > x50)),
+                               "p_over_p10": float(np.mean(f > x10))}
+    w = summary["worst"]["peak_force_N_per_m"]
+    assert w["value"] == force.max() and w["inputs"] == points[int(np.argmax(force))]
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "## By `log_end_shape`" in report
+    assert (tmp_path / "out" / "envelope_peak_force_N_per_m.png").exists()
+    rows = (tmp_path / "out" / "results.csv").read_text()
+    assert "'rounded'" in rows
+
+
+@pytest.mark.parametrize("table, words", [
+    ({"values": ["flat", 2.0]}, "parameters.log_end_shape.values[1]=2.0: must be a name"),
+    ({"values": []}, "parameters.log_end_shape.values=[]: must be a non-empty list"),
+    ({"distribution": "uniform", "lo": 0, "hi": 1},
+     "parameters.log_end_shape.distribution='uniform': a categorical input takes values"),
+    ({"values": ["flat", "flat"]}, "a value is repeated"),
+])
+def test_bad_categorical_input_is_named(table, words):
+    raw = shape_config()
+    raw["parameters"]["log_end_shape"] = table
+    with pytest.raises(ConfigError) as e:
+        sweep.from_dict(raw)
+    assert words in str(e.value)
+
+
+def test_unknown_end_shape_is_named_with_its_scenario():
+    raw = shape_config(method="grid")
+    raw["sample"] = {"method": "grid"}
+    raw["parameters"] = {"log_end_shape": {"values": ["flat", "pointed"]}}
+    with pytest.raises(ConfigError, match=r"scenario 1 .*log_end_shape='pointed'"):
+        build_scenarios(sweep.from_dict(raw))

@@ -22,7 +22,7 @@ def _scenario(s: dict, log: dict) -> list:
            f"3D block {s['dam_width_m']:g} m wide."),
         f"* Reservoir {s['water_level_m']:g} m above the base, tailwater "
         f"{s['tailwater_level_m']:g} m, uplift factor {s['uplift_factor']:g}.",
-        f"* Log {s['log_length_m']:g} m × Ø{s['log_diameter_m']:g} m, pitched "
+        f"* Log {s['log_length_m']:g} m × Ø{s['log_diameter_m']:g} m, {_end(s)}, pitched "
         f"{s['log_pitch_deg']:g}°, floating with draft {log['draft_m']:.3f} m (axis at "
         f"{log['axis_elevation_m']:.3f} m), {s['log_speed_m_s']:g} m/s along its axis, "
         f"friction μ = {s['friction_mu']:g}, added-mass coefficient "
@@ -36,6 +36,18 @@ def _scenario(s: dict, log: dict) -> list:
            "the log's end is elastic to the end (the upper bound of the force)."), ""]
 
 
+def _end(s: dict) -> str:
+    """The front end's shape in words, with its defaults (chamfer D/8, cap radius D)."""
+    shape, D = s.get("log_end_shape", "flat"), s["log_diameter_m"]
+    if shape == "chamfered":
+        c = s.get("log_end_chamfer_m") or D / 8
+        return f"front end chamfered {c:g} m at 45°"
+    if shape == "rounded":
+        rho = s.get("log_end_radius_m") or D
+        return f"front end a spherical cap of radius {rho:g} m"
+    return "flat (sawn) front end"
+
+
 def _limits(st2: dict | None, westergaard: bool = False, dim: int = 2) -> list:
     water = ("Westergaard's added mass of the reservoir on the upstream face included"
              if westergaard else "no Westergaard added mass of the reservoir on the dam")
@@ -47,6 +59,14 @@ def _limits(st2: dict | None, westergaard: bool = False, dim: int = 2) -> list:
            f"* Linear elasticity, small strain and small rotation; {wood}, no "
            f"concrete cracking, {water}, no "
            "water damping. The ratios below say how far each neglected effect is.", ""]
+    if crushes:
+        out += ["* Repeatability: a pitched log whose corner crushes rotates and touches the "
+                "face again at grazing speed; those late re-contacts are sensitive to "
+                "rounding, so the impulse, the contact duration, the heel and toe stresses "
+                "and (in 3D) the peak force repeat to about 1 % between runs that differ by "
+                "round-off (two MPI ranks against one, another machine), not to 1e-8 as an "
+                "elastic end does (docs/crushing.md). Read them to two significant figures.",
+                ""]
     if st2:
         out += [
             "| check | value | limit | ratio |", "|---|---|---|---|",

@@ -54,13 +54,13 @@ class LogMesh:
     so it costs no meshing and no form compilation (the forms hold no density). Serial."""
 
     def __init__(self, length_m: float, diameter_m: float, E: float, nu: float,
-                 h_m: float = None, comm=MPI.COMM_SELF):
+                 h_m: float = None, comm=MPI.COMM_SELF, end=None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         self.length_m, self.diameter_m = float(length_m), float(diameter_m)
         h = h_m if h_m is not None else diameter_m / 4
         self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(comm, length_m,
-                                                                         diameter_m, h)
+                                                                         diameter_m, h, end)
         self.V = compat.vector_space(self.msh)
         mat = Material(E_Pa=E, nu=nu, rho_kg_m3=1.0, name="wood")
         u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
@@ -83,12 +83,13 @@ class LogModel:
     ``rho_effective_kg_m3``: the wood's density with the added mass of the water,
     ρ (1 + C_a); ``E``, ``nu``: the wood's along-grain modulus (Pa) and Poisson's ratio;
     ``h_m``: element size (default D/4); ``mesh``: a :class:`LogMesh` of the same length,
-    diameter, E and ν to reuse (made here when None). Serial.
+    diameter, E and ν to reuse (made here when None); ``end``: the front end's
+    :class:`~flexcontact.meshes.log_end.LogEnd` (None: flat). Serial.
     """
 
     def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
                  E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
-                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None):
+                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None, end=None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
@@ -98,7 +99,8 @@ class LogModel:
         self.dt, self.theta = float(dt_s), float(theta)
         self.factorizations, self.back_substitutions = 0, 0
         t0 = time.perf_counter()
-        self.mesh = mesh if mesh is not None else LogMesh(length_m, diameter_m, E, nu, h_m, comm)
+        self.mesh = mesh if mesh is not None else LogMesh(length_m, diameter_m, E, nu, h_m, comm,
+                                                          end)
         self.msh, self.cell_tags, self.facet_tags = (self.mesh.msh, self.mesh.cell_tags,
                                                      self.mesh.facet_tags)
         self.V = self.mesh.V

@@ -16,7 +16,7 @@ def render_stress_picture(xdmf_path, png_path, scale: float,
                           timeout_s: float = 120.0,
                           bound: float | None = None) -> tuple[bool, str]:
     """Render the last time of ``xdmf_path`` warped by ``scale`` and coloured by ``field``
-    (cells tagged ``body_tag`` only, if given) to ``png_path``, on the colour scale
+    (cells tagged ``body_tag`` only, if given: one tag or several) to ``png_path``, on the colour scale
     ±``bound`` (values beyond it saturate; None: the field's largest magnitude). Returns
     (done, message): done is False, with the reason, when pvbatch or xvfb-run is missing
     or fails."""
@@ -24,7 +24,9 @@ def render_stress_picture(xdmf_path, png_path, scale: float,
     if pvbatch is None:
         return False, "pvbatch not found (Debian packages paraview, python3-paraview)"
     cmd = [pvbatch, str(SCRIPT), str(xdmf_path), str(png_path), repr(float(scale)), field]
-    cmd.append(str(int(body_tag)) if body_tag is not None else "all")
+    tags = ([] if body_tag is None else
+            [body_tag] if np.isscalar(body_tag) else list(body_tag))
+    cmd.append(",".join(str(int(t)) for t in tags) if tags else "all")
     if bound is not None:
         cmd.append(repr(float(bound)))
     if xvfb is not None:
@@ -43,22 +45,3 @@ def render_stress_picture(xdmf_path, png_path, scale: float,
         tail = (proc.stderr or proc.stdout)[-400:].strip()
         return False, f"pvbatch exited with {proc.returncode}: {tail}"
     return True, "rendered by pvbatch" + (" under xvfb-run" if xvfb else "")
-
-
-def warp_scale(u, cell_tags, tag: int, length_m: float, fraction: float = 0.05) -> float:
-    """Warp factor that moves the body tagged ``tag`` by ``fraction`` × ``length_m`` at its
-    largest displacement (its own nodes only: the log's rigid travel would swamp the dam's
-    millimetres). Collective."""
-    import dolfinx.fem
-    from mpi4py import MPI
-    from .. import compat
-    V = u.function_space
-    tdim = V.mesh.topology.dim
-    compat.create_connectivity(V.mesh, tdim, tdim)  # DOLFINx 0.9 needs it for cell entities
-    cells = cell_tags.indices[cell_tags.values == tag]
-    blocks = dolfinx.fem.locate_dofs_topological(V, tdim, cells)
-    bs = V.dofmap.index_map_bs
-    vals = u.x.array.reshape(-1, bs)[blocks]
-    local = float(np.linalg.norm(vals, axis=1).max(initial=0.0))
-    umax = V.mesh.comm.allreduce(local, op=MPI.MAX)
-    return fraction * length_m / max(umax, 1e-30)

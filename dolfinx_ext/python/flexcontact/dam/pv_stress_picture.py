@@ -1,18 +1,18 @@
 """Run by ParaView's pvbatch (not imported by flexcontact): a picture of the dam's stress.
 
-    pvbatch pv_stress_picture.py FILE.xdmf OUT.png SCALE FIELD [BODY_TAG|all [BOUND]]
+    pvbatch pv_stress_picture.py FILE.xdmf OUT.png SCALE FIELD [TAGS|all [BOUND]]
 
-Reads the last time of FILE.xdmf, keeps the cells whose ``cell_tag`` is BODY_TAG (the
-dam) if given, warps them by ``displacement_m`` × SCALE, colours them by the cell field
+Reads the last time of FILE.xdmf, keeps the cells whose ``cell_tag`` is one of TAGS (comma
+separated, e.g. the dam and the log) if given, warps them by ``displacement_m`` × SCALE, colours them by the cell field
 FIELD (blue-white-red, symmetric about zero so that tension is red, on ±BOUND if given:
 beyond it the colours saturate, so that a singular peak does not wash out the rest) and
 saves OUT.png (1200 × 800). Needs a display: run it under xvfb-run.
 """
 import sys
 
-from paraview.simple import (ColorBy, CreateRenderView, GetColorTransferFunction, GetScalarBar,
-                             Render, SaveScreenshot, Show, Threshold, WarpByVector,
-                             Xdmf3ReaderT)
+from paraview.simple import (AppendDatasets, ColorBy, CreateRenderView,
+                             GetColorTransferFunction, GetScalarBar, Render, SaveScreenshot, Show,
+                             Threshold, WarpByVector, Xdmf3ReaderT)
 
 path, out, scale, field = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.argv[4]
 reader = Xdmf3ReaderT(FileName=[path])
@@ -21,13 +21,16 @@ times = reader.TimestepValues
 t = times if isinstance(times, float) else (list(times) or [0.0])[-1]
 source = reader
 if len(sys.argv) > 5 and sys.argv[5] != "all":
-    tag = float(sys.argv[5])
-    source = Threshold(Input=reader)
-    source.Scalars = ["CELLS", "cell_tag"]
-    try:  # ParaView ≥ 5.10
-        source.LowerThreshold, source.UpperThreshold = tag, tag
-    except AttributeError:
-        source.ThresholdRange = [tag, tag]
+    parts = []
+    for tag in map(float, sys.argv[5].split(",")):
+        part = Threshold(Input=reader)
+        part.Scalars = ["CELLS", "cell_tag"]
+        try:  # ParaView ≥ 5.10
+            part.LowerThreshold, part.UpperThreshold = tag, tag
+        except AttributeError:
+            part.ThresholdRange = [tag, tag]
+        parts.append(part)
+    source = parts[0] if len(parts) == 1 else AppendDatasets(Input=parts)
 warp = WarpByVector(Input=source)
 warp.Vectors = ["POINTS", "displacement_m"]
 warp.ScaleFactor = scale

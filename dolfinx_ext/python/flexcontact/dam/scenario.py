@@ -49,6 +49,7 @@ import numpy as np
 
 from ..forms import Material
 from ..forms.loads import STANDARD_GRAVITY_M_S2, WATER_DENSITY_KG_M3
+from ..meshes.log_end import LogEnd
 from .buoyancy import floating_draft_m
 
 CONCRETE = Material(E_Pa=25e9, nu=0.2, rho_kg_m3=2400.0, name="concrete")
@@ -97,6 +98,11 @@ class DamScenario:
     log_pitch_deg: float = 10.0
     log_yaw_deg: float = 0.0
     log_gap_m: float = 0.02
+    # the front end (meshes/log_end.py): "flat", "chamfered" (bevel log_end_chamfer_m,
+    # None: D/8) or "rounded" (a spherical cap of radius log_end_radius_m >= D/2, None: D)
+    log_end_shape: str = "flat"
+    log_end_chamfer_m: Optional[float] = None
+    log_end_radius_m: Optional[float] = None
     # stage 2 (impact)
     log_speed_m_s: float = 2.0
     friction_mu: float = 0.5
@@ -215,12 +221,21 @@ class DamScenario:
             return np.array([math.cos(t), math.sin(t)])
         return np.array([math.cos(t) * math.cos(p), math.cos(t) * math.sin(p), math.sin(t)])
 
+    @property
+    def log_end(self) -> LogEnd:
+        """The front end's shape, with the defaults filled in (chamfer D/8, cap radius D)."""
+        D = self.log_diameter_m
+        c = D / 8 if self.log_end_chamfer_m is None else self.log_end_chamfer_m
+        rho = D if self.log_end_radius_m is None else self.log_end_radius_m
+        return LogEnd(self.log_end_shape, c, rho)
+
+    def _log_support(self, direction: np.ndarray):
+        return self.log_end.support(self.log_length_m, self.log_radius_m, self.log_axis,
+                                    direction)
+
     def _log_reach(self, direction: np.ndarray) -> float:
         """Largest extent of the log beyond its centre along a unit ``direction``."""
-        a, R, L = self.log_axis, self.log_radius_m, self.log_length_m
-        c = abs(float(a @ direction))
-        # Support function of the 2D rectangle and of the 3D cylinder alike.
-        return 0.5 * L * c + R * math.sqrt(max(1.0 - c * c, 0.0))
+        return self._log_support(direction)[0]
 
     @property
     def log_centre(self) -> np.ndarray:
@@ -235,27 +250,32 @@ class DamScenario:
 
     @property
     def log_front_point(self) -> np.ndarray:
-        """The log's point nearest the dam (first contact): a corner of the front end, or
-        the front end's centre for a log square to the face."""
-        a, R = self.log_axis, self.log_radius_m
-        ex = np.eye(self.dim)[0]
-        radial = ex - (a @ ex) * a
-        n = np.linalg.norm(radial)
-        offset = R * radial / n if n > 1e-12 else np.zeros(self.dim)
-        return self.log_centre + 0.5 * self.log_length_m * a + offset
+        """The log's point nearest the dam (first contact): a corner of a flat end, a point
+        of a bevel's rim or of the cap, or the front face's centre for a log square to the
+        face."""
+        _, x, q = self._log_support(np.eye(self.dim)[0])
+        return self.log_centre + x * self.log_axis + q
 
     @property
     def log_lowest_elevation_m(self) -> float:
         ez = np.eye(self.dim)[-1]
-        return float(self.log_centre[-1] - self._log_reach(ez))
+        return float(self.log_centre[-1] - self._log_reach(-ez))
 
     def log_mass_kg(self) -> float:
-        """Mass of the cylindrical log, ρ π R² L (kg)."""
-        return self.wood.rho_kg_m3 * math.pi * self.log_radius_m ** 2 * self.log_length_m
+        """Mass of the 3D log, ρ times its volume (πR²L less what the end's shape removes),
+        kg."""
+        if self.log_end_shape == "flat":
+            return self.wood.rho_kg_m3 * math.pi * self.log_radius_m ** 2 * self.log_length_m
+        return self.wood.rho_kg_m3 * self.log_end.volume_m3(self.log_length_m,
+                                                            self.log_radius_m)
 
     def log_mass_2d_kg_per_m(self) -> float:
-        """Mass per unit width of the plane-strain log (a slab L × D), ρ L D (kg/m)."""
-        return self.wood.rho_kg_m3 * self.log_length_m * self.log_diameter_m
+        """Mass per unit width of the plane-strain log (a slab L × D, less what the end's
+        shape removes), kg/m."""
+        if self.log_end_shape == "flat":
+            return self.wood.rho_kg_m3 * self.log_length_m * self.log_diameter_m
+        return self.wood.rho_kg_m3 * self.log_end.area_m2(self.log_length_m,
+                                                          self.log_radius_m)
 
     def log_added_mass_kg(self) -> float:
         """C_a times the displaced water's mass (= the floating log's mass), kg."""

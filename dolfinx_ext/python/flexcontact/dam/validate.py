@@ -52,7 +52,8 @@ def _check_types(s):
                    "log_speed_m_s": "the log's speed must be >= 0 m/s (it moves towards the "
                                     "dam; the direction is its axis)"}.get(name, "must be >= 0")
             _fail(name, v, why)
-    for name in ("mesh_size_far_m", "mesh_size_impact_m", "mesh_size_contact_m"):
+    for name in ("mesh_size_far_m", "mesh_size_impact_m", "mesh_size_contact_m",
+                 "log_end_chamfer_m", "log_end_radius_m"):
         v = getattr(s, name)
         if v is not None and not (_real(v) and v > 0):
             _fail(name, v, "must be None (default) or a finite number > 0")
@@ -95,6 +96,7 @@ def _check_log(s):
                            "faces the dam)")
     if s.dim == 2 and s.log_yaw_deg != 0:
         _fail("log_yaw_deg", s.log_yaw_deg, "a yaw angle needs the 3D variant (dim=3)")
+    s.log_end.check(s.log_diameter_m)
     rho, rho_w = s.wood.rho_kg_m3, s.water_density_kg_m3
     if not 0 < rho < rho_w:
         _fail("wood.rho_kg_m3", rho, f"the log must be lighter than water "

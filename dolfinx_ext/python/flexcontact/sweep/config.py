@@ -38,8 +38,11 @@ from .errors import ConfigError
 
 SWEPT = ("log_length_m", "log_diameter_m", "wood_density_kg_m3", "log_speed_m_s",
          "log_pitch_deg", "log_yaw_deg", "friction_mu", "water_level_m",
-         "added_mass_coefficient", "wood_crushing_strength_Pa")
+         "added_mass_coefficient", "wood_crushing_strength_Pa", "log_end_shape",
+         "log_end_chamfer_m", "log_end_radius_m")
 """Inputs a sweep may vary; ``wood_density_kg_m3`` is the wood Material's ``rho_kg_m3``."""
+CATEGORICAL = ("log_end_shape",)
+"""Swept inputs that take names, not numbers: ``values = ["flat", "rounded"]`` only."""
 METHODS = ("grid", "lhs", "random")
 ENGINES = ("serial", "processes", "mpi", "dask")
 EVALUATORS = ("reuse", "monolithic")
@@ -143,7 +146,7 @@ def _parameters(table: dict, method: str) -> dict:
         if name not in SWEPT:
             raise ConfigError(f"parameters.{name}={table[name]!r}: unknown swept input "
                               f"(allowed: {list(SWEPT)})")
-        d = distributions.parse(name, table[name])
+        d = distributions.parse(name, table[name], categorical=name in CATEGORICAL)
         if method == "grid":
             d.values  # raises unless a values list
         out[name] = d

@@ -5,6 +5,7 @@ random draws go through one function.
 Config forms (``[parameters.<name>]``)::
 
     values = [1.0, 2.0, 3.0]                          # a grid axis; sampled: equally likely
+    values = ["flat", "rounded"]                      # a categorical input: names only
     distribution = "uniform",    lo = 1.0, hi = 3.0
     distribution = "normal",     mean = 2.0, sd = 0.5, lo = 1.0, hi = 3.0   # truncated
     distribution = "lognormal",  median = 2.0, sigma = 0.3 [, lo = ..., hi = ...]
@@ -46,6 +47,15 @@ class Distribution:
     args: tuple  # values (kind "values") or the kind's keys as sorted (key, value) pairs
 
     @property
+    def categorical(self) -> bool:
+        """Whether the values are names (sampled uniformly, no order)."""
+        return self.kind == "values" and all(isinstance(v, str) for v in self.args)
+
+    def value(self, v):
+        """One sampled value as the scenario takes it: a name, or a float."""
+        return v if self.categorical else float(v)
+
+    @property
     def values(self) -> tuple:
         if self.kind != "values":
             raise ConfigError(f"parameters.{self.name}: a grid needs values = [...], "
@@ -78,19 +88,22 @@ class Distribution:
         if self.kind == "values":
             k = len(self.args)
             idx = np.minimum((u * k).astype(int), k - 1)
-            return np.asarray(self.args, dtype=float)[idx]
+            return np.asarray(self.args, dtype=object if self.categorical else float)[idx]
         law, lo, hi = self._scipy()
         f_lo, f_hi = law.cdf(lo), law.cdf(hi)
         x = law.ppf(f_lo + u * (f_hi - f_lo))
         return np.clip(x, lo, hi)
 
 
-def parse(name: str, table) -> Distribution:
-    """The Distribution of ``[parameters.<name>]`` (a dict); raises ConfigError."""
+def parse(name: str, table, categorical: bool = False) -> Distribution:
+    """The Distribution of ``[parameters.<name>]`` (a dict); raises ConfigError. A
+    ``categorical`` input takes ``values = [names]`` only."""
     where = f"parameters.{name}"
     if not isinstance(table, dict):
         raise ConfigError(f"{where}={table!r}: must be a table (values = [...] or "
                           f"distribution = ...)")
+    if categorical:
+        return _categorical(where, name, table)
     if "values" in table:
         extra = sorted(set(table) - {"values"})
         if extra:
@@ -122,6 +135,21 @@ def parse(name: str, table) -> Distribution:
                           f"the truncation interval has no probability under "
                           f"distribution = {kind!r} (no support)")
     return d
+
+
+def _categorical(where: str, name: str, table: dict) -> Distribution:
+    for key in sorted(set(table) - {"values"}):
+        raise ConfigError(f"{where}.{key}={table[key]!r}: a categorical input takes "
+                          f"values = [names] only")
+    vals = table.get("values")
+    if not isinstance(vals, list) or not vals:
+        raise ConfigError(f"{where}.values={vals!r}: must be a non-empty list of names")
+    for i, v in enumerate(vals):
+        if not isinstance(v, str):
+            raise ConfigError(f"{where}.values[{i}]={v!r}: must be a name (a string)")
+    if len(set(vals)) != len(vals):
+        raise ConfigError(f"{where}.values={vals!r}: a value is repeated")
+    return Distribution(name, "values", tuple(vals))
 
 
 def _check_support(where: str, kind: str, a: dict) -> None:

@@ -42,10 +42,17 @@ def envelope_plots(folder: Path, rows: list, inputs: list, outputs: list) -> lis
         for ax in axes.flat[len(inputs):]:
             ax.set_visible(False)
         for ax, name in zip(axes.flat, inputs):
-            x = np.array([float(r["inputs"][name]) for r in rows])
+            raw = [r["inputs"][name] for r in rows]
+            names = sorted({v for v in raw if isinstance(v, str)})
+            # A categorical input: one column of points per name, the envelope its maxima.
+            x = (np.array([names.index(v) for v in raw], float) if names else
+                 np.array([float(v) for v in raw]))
             ax.plot(x, y, ".", ms=3, alpha=0.5, label="scenarios")
             ex, ey = envelope(x, y)
-            ax.plot(ex, ey, "-", color="C3", label="upper envelope")
+            ax.plot(ex, ey, "-" if not names else "_", ms=14, color="C3",
+                    label="upper envelope")
+            if names:
+                ax.set_xticks(range(len(names)), names)
             ax.set_xlabel(name)
         for row in axes:
             row[0].set_ylabel(o)

@@ -58,11 +58,13 @@ def _material(key, table, default, Material):
 
 
 def sample_points(cfg) -> list:
-    """The swept inputs of every scenario: a list of {name: float}, in id order."""
+    """The swept inputs of every scenario: a list of {name: float, or str for a categorical
+    input}, in id order."""
     names = cfg.names
+    dists = [cfg.parameters[n] for n in names]
     if cfg.method == "grid":
-        axes = [cfg.parameters[n].values for n in names]
-        return [dict(zip(names, map(float, p))) for p in itertools.product(*axes)]
+        return [{n: d.value(v) for n, d, v in zip(names, dists, p)}
+                for p in itertools.product(*(d.values for d in dists))]
     rng = np.random.default_rng(cfg.seed)
     n, d = cfg.n, len(names)
     if cfg.method == "lhs":
@@ -72,7 +74,8 @@ def sample_points(cfg) -> list:
     else:
         u = rng.random((n, d))
     cols = [cfg.parameters[name].ppf(u[:, j]) for j, name in enumerate(names)]
-    return [{name: float(cols[j][i]) for j, name in enumerate(names)} for i in range(n)]
+    return [{name: dists[j].value(cols[j][i]) for j, name in enumerate(names)}
+            for i in range(n)]
 
 
 def scenario_of(base, point: dict):
@@ -105,6 +108,7 @@ def build_scenarios(cfg) -> tuple:
 
 
 def point_hash(point: dict) -> str:
-    """A short hash of one scenario's swept inputs (exact float values)."""
-    text = json.dumps({k: float(v).hex() for k, v in point.items()}, sort_keys=True)
+    """A short hash of one scenario's swept inputs (exact float values, names as such)."""
+    text = json.dumps({k: v if isinstance(v, str) else float(v).hex()
+                       for k, v in point.items()}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]

@@ -56,20 +56,50 @@ def _survival(sample_sorted: np.ndarray, at: np.ndarray) -> np.ndarray:
     return (n - np.searchsorted(sample_sorted, at, side="right")) / n
 
 
+def categorical(rows: list, name: str) -> bool:
+    """Whether the input ``name`` takes names (a categorical input), not numbers."""
+    return any(isinstance(r["inputs"][name], str) for r in rows)
+
+
 def spearman(rows: list, inputs: list, outputs: list) -> dict:
-    """{output: {input: Spearman ρ}}; NaN where an input or output is constant."""
+    """{output: {input: Spearman ρ}} over the numeric inputs; NaN where an input or output
+    is constant."""
     from scipy.stats import spearmanr
     out = {}
+    numeric = [n for n in inputs if not categorical(rows, n)]
     for o in outputs:
         y = column(rows, o)
         out[o] = {}
-        for name in inputs:
+        for name in numeric:
             x = np.array([float(r["inputs"][name]) for r in rows])
             ok = np.isfinite(y)
             if ok.sum() < 3 or np.ptp(x[ok]) == 0 or np.ptp(y[ok]) == 0:
                 out[o][name] = float("nan")
             else:
                 out[o][name] = float(spearmanr(x[ok], y[ok]).correlation)
+    return out
+
+
+def by_category(rows: list, name: str, outputs: list) -> dict:
+    """{output: {category: {n, median, max, p_over_median, p_over_p10}}} for a categorical
+    input ``name``: per category, the share of its scenarios above the value all scenarios
+    exceed with probability 1/2 and 1/10 (so a category that carries the tail shows it)."""
+    cats = sorted({r["inputs"][name] for r in rows})
+    out = {}
+    for o in outputs:
+        y = column(rows, o)
+        ok = np.isfinite(y)
+        if not ok.any():
+            continue
+        x50, x10 = np.quantile(y[ok], [0.5, 0.9])
+        out[o] = {}
+        for c in cats:
+            yc = np.array([v for v, r in zip(y, rows) if r["inputs"][name] == c])
+            yc = yc[np.isfinite(yc)]
+            out[o][c] = ({"n": int(yc.size), "median": float(np.median(yc)),
+                          "max": float(yc.max()), "p_over_median": float(np.mean(yc > x50)),
+                          "p_over_p10": float(np.mean(yc > x10))} if yc.size else
+                         {"n": 0})
     return out
 
 

@@ -33,6 +33,8 @@ def summarize(run: dict, rows: list, inputs: list, outputs: list, cfg) -> dict:
         s["worst"][o] = None if r is None else {"id": r["id"], "value": r["outputs"][o],
                                                 "inputs": r["inputs"], "outputs": r["outputs"]}
     s["spearman"] = stats.spearman(rows, inputs, outputs)
+    s["by_category"] = {n: stats.by_category(rows, n, list(stats.KEY_OUTPUTS))
+                        for n in inputs if stats.categorical(rows, n)}
     if cfg.method != "grid":
         s["exceedance"] = {"note": CONDITIONAL}
         for o in stats.KEY_OUTPUTS:
@@ -53,6 +55,8 @@ def figures(folder: Path, summary: dict, rows: list, inputs: list, outputs: list
 
 
 def _fmt(v) -> str:
+    if isinstance(v, str):
+        return v
     if isinstance(v, int):
         return str(v)
     return "nan" if v is None or not math.isfinite(v) else f"{v:.6g}"
@@ -85,10 +89,24 @@ def markdown(summary: dict, inputs: list) -> str:
             at = s["exceedance"][o]["exceeded_at"]
             L.append(f"| {o} | " + " | ".join(_fmt(at.get(str(p))) if str(p) in at else "—"
                                               for p in PROBABILITIES) + " |")
-    L += ["", "## Rank correlation (Spearman) of each output with each input", "",
-          "| output | " + " | ".join(inputs) + " |", "|---|" + "---|" * len(inputs)]
+    numeric = [n for n in inputs if n not in s.get("by_category", {})]
+    L += ["", "## Rank correlation (Spearman) of each output with each numeric input", "",
+          "| output | " + " | ".join(numeric) + " |", "|---|" + "---|" * len(numeric)]
     for o, d in s["spearman"].items():
-        L.append(f"| {o} | " + " | ".join(_fmt(d[n]) for n in inputs) + " |")
+        L.append(f"| {o} | " + " | ".join(_fmt(d[n]) for n in numeric) + " |")
+    for name, table in s.get("by_category", {}).items():
+        L += ["", f"## By `{name}`", "",
+              "Per category: its scenarios, their median and largest value, and the share "
+              "of them above the median and above the value exceeded with probability 0.1 "
+              "among all scenarios (1/2 and 1/10 if the category does not matter).", "",
+              "| output | category | n | median | max | P[> median] | P[> 10 % value] |",
+              "|---|---|---|---|---|---|---|"]
+        for o, cats in table.items():
+            for c, d in cats.items():
+                if d["n"]:
+                    L.append(f"| {o} | {c} | {d['n']} | {_fmt(d['median'])} | "
+                             f"{_fmt(d['max'])} | {_fmt(d['p_over_median'])} | "
+                             f"{_fmt(d['p_over_p10'])} |")
     c = s["counts"]
     keys = sorted((set(c["factorizations"]) | set(c["back_substitutions"])) - {"total"})
     keys.append("total")
