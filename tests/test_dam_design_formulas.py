@@ -85,7 +85,7 @@ def test_comparison_demo_in_2d(tmp_path):
     with open(folder / "comparison.csv") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 1 and (folder / "comparison.md").is_file()
-    row = {k: float(v) for k, v in rows[0].items() if k not in ("contact_ended",)}
+    row = {k: float(v) for k, v in rows[0].items() if not k.startswith("contact_ended")}
     s = DamScenario(log_speed_m_s=2.0)
     w = s.wood
     expected = dfm.all_formulas_N(s.log_mass_kg(), 2.0, s.log_diameter_m, 10.0, w.E_Pa,
@@ -105,3 +105,4 @@ def test_comparison_demo_in_2d(tmp_path):
         assert 0 < crushing < per_metre, end
         assert crushing <= s.wood_crushing_strength_Pa * D, (end, crushing)
         assert row[f"crush_depth_{end}_m"] > 0, end
+        assert rows[0][f"contact_ended_crushing_{end}"] == "True", end
