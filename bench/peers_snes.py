@@ -86,7 +86,7 @@ class PenaltySNES:
         self.F, self.J = dolfinx.fem.form(F), dolfinx.fem.form(J)
         self.contact = dolfinx.fem.form(contact)
         self.A = dolfinx.fem.petsc.create_matrix(self.J)
-        self.b = dolfinx.fem.petsc.create_vector(self.F)
+        self.b = compat.create_petsc_vector(V)
         self.snes = self._snes()
         self.iterations = []
 

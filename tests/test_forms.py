@@ -29,8 +29,8 @@ def _cell_values(msh, expr):
 
 
 def _solve(a, L, bcs):
-    problem = fem.petsc.LinearProblem(a, L, bcs=bcs, petsc_options={"ksp_type": "preonly",
-                                                                    "pc_type": "lu"})
+    problem = compat.linear_problem(a, L, bcs, {"ksp_type": "preonly", "pc_type": "lu"},
+                                    "forms_test_")
     return problem.solve()
 
 

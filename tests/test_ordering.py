@@ -106,5 +106,5 @@ def test_auto_is_metis_in_3d_and_for_large_schur_factors(dim, n, schur, expected
     _, _, info = fc.flexibility(K, dofs if schur else dofs[:0])
     assert info["ordering"] == expected
     assert (info["mumps_ordering"] == "metis") == (expected == "metis")
-    # Both supported PETSc generations take our ordering: no fallback to MUMPS's own.
+    # Every supported PETSc generation takes our ordering: no fallback to MUMPS's own.
     assert info["ordering_fallback"] == ""

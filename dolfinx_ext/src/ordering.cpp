@@ -2,16 +2,14 @@
 
 #include "ordering.h"
 #include "collective.h"
+#include "mumps_layout.h"
 #include "petsc_error.h"
 
-#include <dmumps_c.h>
 #include <metis.h>
-#include <petsc/private/matimpl.h>
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <cstring>
 #include <mpi.h>
 #include <stdexcept>
 #include <utility>
@@ -22,16 +20,6 @@ namespace
 {
 constexpr std::array<std::pair<const char*, int>, 6> kOrderings{
     {{"metis", 1}, {"mumps", 7}, {"amd", 0}, {"amf", 2}, {"pord", 4}, {"qamd", 6}}};
-
-/// @brief Owns one METIS/MUMPS-sized integer buffer from PetscMalloc (PETSc frees PERM_IN
-/// with PetscFree when the factor is destroyed).
-int* petsc_ints(std::size_t n)
-{
-  int* p = nullptr;
-  if (PetscMalloc1(n, &p) != 0 or (n > 0 and !p))
-    throw std::bad_alloc();
-  return p;
-}
 
 /// @brief The compressed nodal graph of K (rows grouped by the block size bs, no self
 /// loops): METIS's xadj and adjncy.
@@ -246,9 +234,9 @@ std::vector<int> flexcontact::metis_pivot_order_gathered(Mat K, std::span<const 
 
 void flexcontact::reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm_in)
 {
-  // PETSc keeps MUMPS's structure first in the factor's data (Mat_MUMPS::id); these are the
-  // values its analysis of a symmetric matrix on one process must have left there.
-  auto* id = static_cast<DMUMPS_STRUC_C*>(F->data);
+  // The values PETSc's analysis of a symmetric matrix on one process must have left in the
+  // MUMPS structure it calls (mumps_layout.h).
+  DMUMPS_STRUC_C* id = mumps_struct(F);
   PetscInt infog7 = -1;
   PetscErrorScope err;
   err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
@@ -257,18 +245,17 @@ void flexcontact::reanalyse(Mat F, PetscInt N, int icntl7, std::vector<int> perm
     throw MumpsLayoutError(
         "cannot give MUMPS an ordering through this PETSc (its MUMPS factor is not laid out "
         "as expected); use ordering='mumps'");
+  if (icntl7 == 1 and perm_in.size() != static_cast<std::size_t>(N))
+    throw std::invalid_argument("PERM_IN has the wrong size");
+  // MUMPS reads PERM_IN in the analysis only; PETSc's own pointer (none) is put back after,
+  // so that PETSc frees only what it allocated.
+  int* const petsc_perm_in = id->perm_in;
   if (icntl7 == 1)
-  {
-    if (perm_in.size() != static_cast<std::size_t>(N))
-      throw std::invalid_argument("PERM_IN has the wrong size");
-    int* p = petsc_ints(perm_in.size());
-    std::memcpy(p, perm_in.data(), perm_in.size() * sizeof(int));
-    PetscFree(id->perm_in); // the factor owns PERM_IN; none is set unless redone here
-    id->perm_in = p;
-  }
+    id->perm_in = perm_in.data();
   id->icntl[6] = icntl7;
   id->job = 1;
   dmumps_c(id);
+  id->perm_in = petsc_perm_in;
   if (id->infog[0] < 0)
     throw std::runtime_error("MUMPS failed in the analysis with ordering ICNTL(7)="
                              + std::to_string(icntl7) + ": INFOG(1)="

@@ -10,8 +10,8 @@
 /// nested-dissection ordering from METIS (METIS_NodeND on the graph of the mesh nodes,
 /// expanded to their DOFs) is handed to MUMPS here: after PETSc's analysis has set MUMPS up,
 /// the analysis is redone on the same MUMPS instance with ICNTL(7) = 1 and PERM_IN. That
-/// needs MUMPS's own structure, which PETSc keeps first in the factor's private data; it is
-/// checked (job, size, symmetry, INFOG) before use and INFOG(7) = 1 is checked after, so a
+/// needs MUMPS's own structure, which PETSc keeps in the factor's private data (where:
+/// mumps_layout.h); it is checked (job, size, symmetry, INFOG) before use and INFOG(7) = 1 is checked after, so a
 /// PETSc that lays it out otherwise never gives a wrong factor: "auto" then keeps MUMPS's own
 /// ordering (and says why in info["ordering_fallback"]), an explicit "metis" is a clear error.
 

@@ -2,11 +2,9 @@
 
 #include "schur_solve.h"
 #include "flexibility.h"
+#include "mumps_layout.h"
 #include "ordering.h"
 #include "petsc_error.h"
-
-#include <dmumps_c.h>
-#include <petsc/private/matimpl.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -20,7 +18,7 @@ const char* kLayout = "cannot split solves with this PETSc's MUMPS factor into c
                       "expansion (its MUMPS structure is not laid out as expected)";
 
 /// @brief F's MUMPS structure if it is what PETSc's serial Cholesky factor with a Schur
-/// complement on `dofs` must hold (PETSc keeps it first in the factor's data, ordering.h),
+/// complement on `dofs` must hold (where PETSc keeps it: mumps_layout.h),
 /// checked against PETSc's public queries; else MumpsLayoutError. Reads the Schur list only
 /// once the scalar fields agree.
 DMUMPS_STRUC_C* checked_mumps(Mat F, PetscInt N, std::span<const PetscInt> dofs)
@@ -33,7 +31,7 @@ DMUMPS_STRUC_C* checked_mumps(Mat F, PetscInt N, std::span<const PetscInt> dofs)
   err.check(MatMumpsGetInfog(F, 7, &infog7), "MatMumpsGetInfog(7)");
   err.check(MatMumpsGetIcntl(F, 19, &icntl19), "MatMumpsGetIcntl(19)");
   err.check(MatMumpsGetIcntl(F, 26, &icntl26), "MatMumpsGetIcntl(26)");
-  auto* id = static_cast<DMUMPS_STRUC_C*>(F->data);
+  DMUMPS_STRUC_C* id = mumps_struct(F);
   const auto n_c = static_cast<PetscInt>(dofs.size());
   bool ok = id and id->n == N and (id->sym == 1 or id->sym == 2) and id->par == 1
             and (id->job == 2 or id->job == 3) and infog1 >= 0 and id->infog[0] == infog1

@@ -7,8 +7,6 @@ petsc4py objects and NumPy arrays (docs/architecture.md §3).
 """
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 
 import dolfinx
@@ -17,26 +15,15 @@ import dolfinx.fem.petsc  # noqa: F401  (submodule must be imported explicitly i
 import dolfinx.io
 import dolfinx.mesh
 
-SUPPORTED = ((0, 5), (0, 9))
-"""The DOLFINx generations flexcontact runs on and is tested on: Debian 12's 0.5 and Debian
-13's 0.9."""
-
-PORTING = ((0, 11),)
-"""Generations being ported (Debian unstable's 0.11): flexcontact imports with a warning that
-says what is missing (docs/architecture.md §8)."""
+SUPPORTED = ((0, 5), (0, 9), (0, 11))
+"""The DOLFINx generations flexcontact runs on and is tested on: Debian 12's 0.5, Debian 13's
+0.9 and Debian unstable's 0.11."""
 
 VERSION = tuple(int(p) for p in dolfinx.__version__.split(".")[:2])
-if VERSION not in SUPPORTED + PORTING:
+if VERSION not in SUPPORTED:
     raise ImportError(
-        f"flexcontact supports DOLFINx 0.5 and 0.9 (0.11 is being ported); this Python sees "
-        f"DOLFINx {dolfinx.__version__} ({dolfinx.__file__})")
-if VERSION in PORTING:
-    warnings.warn(
-        f"flexcontact on DOLFINx {dolfinx.__version__} is being ported: PETSc's MUMPS "
-        "interface of this stack is not laid out as flexcontact's Schur split and METIS "
-        "ordering expect, so increments take two full solves and ordering='metis' is refused "
-        "(use ordering='mumps'); parts of the test suite still fail (docs/architecture.md §8)",
-        UserWarning, stacklevel=2)
+        f"flexcontact supports DOLFINx 0.5, 0.9 and 0.11; this Python sees DOLFINx "
+        f"{dolfinx.__version__} ({dolfinx.__file__})")
 NEW_API = VERSION >= (0, 8)
 GMSH_MODULE = VERSION >= (0, 10)   # dolfinx.io.gmshio became dolfinx.io.gmsh
 PETSC_LA = VERSION >= (0, 10)      # dolfinx.la's PETSc helpers moved to dolfinx.la.petsc
@@ -93,6 +80,8 @@ def geometry_x(msh):
 
 def geometry_dofmap(msh) -> np.ndarray:
     """Geometry nodes of each cell, shape (num_cells, nodes per cell), local numbers."""
+    if VERSION >= (0, 11):  # one dofmap per cell type; `dofmap` is deprecated
+        return msh.geometry.dofmaps[0]
     g = msh.geometry.dofmap
     return g if NEW_API else g.array.reshape(-1, g.offsets[1] - g.offsets[0])
 
@@ -213,6 +202,15 @@ def create_petsc_vector(V):
         return vec
     import dolfinx.la
     return dolfinx.la.create_petsc_vector(V.dofmap.index_map, V.dofmap.index_map_bs)
+
+
+def linear_problem(a, L, bcs, petsc_options: dict, prefix: str):
+    """DOLFINx's LinearProblem of ``a == L``; from 0.10 on it needs an options prefix of its
+    own (``prefix``, e.g. ``"forms_test_"``)."""
+    import dolfinx.fem.petsc
+    extra = {"petsc_options_prefix": prefix} if VERSION >= (0, 10) else {}
+    return dolfinx.fem.petsc.LinearProblem(a, L, bcs=list(bcs), petsc_options=petsc_options,
+                                           **extra)
 
 
 def assemble_matrix(form, bcs, diagonal: float = 1.0):

@@ -25,7 +25,7 @@ TOPOLOGY_TYPES = {
 
 
 # Names DOLFINx gives tags by itself (meshtags, gmshio.model_to_mesh): written as "cell_tag".
-DEFAULT_TAG_NAMES = ("mesh_tags", "Cell tags", "")
+DEFAULT_TAG_NAMES = ("mesh_tags", "Cell tags", "cell_tags", "")
 
 
 def raise_on_any_rank(comm, message: Optional[str], error=ValueError) -> None:
