@@ -200,20 +200,11 @@ def test_crushing_at_the_zone_edge_warns():
     warns as contact there does (ContactZoneWarning, the increment kept)."""
     import warnings
 
-    from demo_runner import A_TARGET, R_HERTZ
-    from flexcontact.meshes import hertz2d
+    from demo_runner import R_HERTZ
     from flexcontact.states import CRUSH
-    steel = forms.Material(E_Pa=200e9, nu=0.3, name="steel")
-    msh, _, facets, geo = hertz2d.build(MPI.COMM_WORLD, R=R_HERTZ, a_expected=A_TARGET,
-                                        zone_factor=1.0, with_cylinder=False)
-    V = compat.vector_space(msh)
-    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    a = forms.elasticity_form(u, v, steel, ufl.dx(domain=msh), "plane_strain")
-    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
-    circle = fc.RigidTarget("circle", point_m=(0.0, R_HERTZ), radius_m=R_HERTZ)
+    from rigid_block_case import rigid_block
     # σ_c far below the Hertz pressure: the whole zone crushes at a modest approach.
-    problem = fc.ContactProblem(a, None, fixed, fc.ContactInterface(
-        facets, tags.MASTER, circle, 0.0, name="crushable", crushing_strength_Pa=1e6))
+    problem, circle, geo = rigid_block(1.0, "crushable", crushing_strength_Pa=1e6)
     w = geo["w"]
     circle.displacement_m = np.array([0.0, -(1.5 * w) ** 2 / R_HERTZ])
     with warnings.catch_warnings(record=True) as caught:

@@ -13,6 +13,7 @@ from mpi4py import MPI
 
 import flexcontact as fc
 from demo_runner import A_TARGET, R_HERTZ, STEEL, assert_inputs, run_demo
+from rigid_block_case import rigid_block
 from flexcontact import analytic, compat, forms
 from flexcontact.contact_profile import elliptic_fit
 from flexcontact.meshes import hertz2d, tags
@@ -191,17 +192,7 @@ def test_sphere_on_plane_mpi_equals_serial(sphere_on_plane, tmp_path):
 
 
 def _rigid_block(zone_factor, zone_edge):
-    """The block of hertz2d under a rigid circle; candidate zone w = zone_factor·a."""
-    msh, cells, facets, geo = hertz2d.build(MPI.COMM_WORLD, R=R_HERTZ, a_expected=A_TARGET,
-                                            zone_factor=zone_factor, with_cylinder=False)
-    V = compat.vector_space(msh)
-    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    a = forms.elasticity_form(u, v, STEEL_M, ufl.dx(domain=msh), "plane_strain")
-    fixed, _ = fc.dirichlet(V, facets, tags.FIXED)
-    circle = fc.RigidTarget("circle", point_m=(0.0, R_HERTZ), radius_m=R_HERTZ)
-    problem = fc.ContactProblem(a, None, fixed, fc.ContactInterface(
-        facets, tags.MASTER, circle, 0.0, name="probe", zone_edge=zone_edge))
-    return problem, circle, geo
+    return rigid_block(zone_factor, "probe", zone_edge=zone_edge)
 
 
 def test_zone_guard_warns_and_records():
