@@ -497,3 +497,16 @@ def test_unknown_end_shape_is_named_with_its_scenario():
     raw["parameters"] = {"log_end_shape": {"values": ["flat", "pointed"]}}
     with pytest.raises(ConfigError, match=r"scenario 1 .*log_end_shape='pointed'"):
         build_scenarios(sweep.from_dict(raw))
+
+
+def test_command_line_names_the_worst_end_shape(tmp_path):
+    """`python -m flexcontact sweep` with a categorical input: it finishes and prints each
+    worst scenario's inputs, the end shape by its name."""
+    cfg = write_toml(tmp_path / "shapes.toml", shape_config(n=6))
+    proc = subprocess.run([sys.executable, "-m", "flexcontact", "sweep", str(cfg), "--out",
+                           str(tmp_path / "out")], env=env_with_fakes(), capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    worst = summary["worst"]["peak_force_N_per_m"]
+    assert f"log_end_shape={worst['inputs']['log_end_shape']}" in proc.stdout

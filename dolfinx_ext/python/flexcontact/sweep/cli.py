@@ -55,5 +55,6 @@ def main(args) -> int:
     for o, w in summary["worst"].items():
         if w is not None:
             print(f"  worst {o}: {w['value']:.6g} (scenario {w['id']}: "
-                  + ", ".join(f"{k}={v:.4g}" for k, v in w["inputs"].items()) + ")")
+                  + ", ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:.4g}"
+                              for k, v in w["inputs"].items()) + ")")
     return 0
