@@ -113,15 +113,16 @@ class ScenarioEvaluator:
         key = log_key(s)
         if key not in self._logs:
             geometry = (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu)
-            if geometry + (s.log_end,) not in self._log_meshes:
+            mesh_key = geometry + (s.log_end,)
+            if mesh_key not in self._log_meshes:
                 t0 = time.perf_counter()
-                self._log_meshes[geometry + (s.log_end,)] = LogMesh(
+                self._log_meshes[mesh_key] = LogMesh(
                     *geometry, h_m=self.base.h_impact_m, comm=self.dam.comm, end=s.log_end)
                 self._log_mesh_s += time.perf_counter() - t0
             self._logs[key] = LogModel(
                 s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
                 s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm,
-                mesh=self._log_meshes[geometry + (s.log_end,)], end=s.log_end)
+                mesh=self._log_meshes[mesh_key])
         return self._logs[key]
 
     def evaluate(self, scenario: DamScenario) -> dict[str, float]:
