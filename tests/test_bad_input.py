@@ -95,19 +95,49 @@ def test_not_converging_is_reported(setup):
     assert problem.increments == []
 
 
-def test_spent_time_budget_is_reported(setup):
-    """A chain whose time budget is spent stops trying and says so in the error."""
-    opts = fc.SolverOptions(time_budget_s=1e-9)
+def test_failing_problem_is_saved_and_reruns_bitwise(setup, tmp_path, monkeypatch):
+    """The error names a file holding the local problem; loading and re-running it gives the
+    same failure, bitwise (docs/solvers.md, "A failing problem as a file")."""
+    monkeypatch.setenv("FLEXCONTACT_PROBLEM_DIR", str(tmp_path))
+    opts = fc.SolverOptions(chain=["projection"], max_iterations=1, tolerance=1e-14)
     problem, (ux, uy) = _problem(setup, solver=opts)
     uy.value = -1e-6
-    with pytest.raises(fc.ConvergenceError, match=r"time budget of 1e-09 s spent"):
+    with pytest.raises(fc.ConvergenceError) as info:
+        problem.step()
+    err = info.value
+    path = err.problem_path
+    assert path is not None and path.startswith(str(tmp_path)), path
+    assert path in str(err) and "load_problem" in str(err)
+    saved = fc.load_problem(path)
+    assert saved.dim == 2 and saved.pairs >= 1
+    assert saved.W.shape == (2 * saved.pairs, 2 * saved.pairs)
+    assert list(saved.options.chain) == ["projection"]
+    assert saved.options.max_iterations == 1 and saved.options.tolerance == 1e-14
+    again = saved.solve()
+    assert not again.converged
+    assert again.residual == err.report["residual"]
+    assert list(again.attempts) == list(err.report["attempts"])
+    # The same failure again is the same file, not a second one.
+    with pytest.raises(fc.ConvergenceError) as info2:
+        problem.step()
+    assert info2.value.problem_path == path
+    assert len(list(tmp_path.iterdir())) == 1
+
+
+def test_spent_work_budget_is_reported(setup):
+    """A chain whose work budget is spent stops trying and says so in the error."""
+    opts = fc.SolverOptions(work_budget_gflop=1e-9)
+    problem, (ux, uy) = _problem(setup, solver=opts)
+    uy.value = -1e-6
+    with pytest.raises(fc.ConvergenceError, match=r"work budget of 1e-09 Gflop spent"):
         problem.step()
     assert problem.increments == []
 
 
-def test_bad_time_budget_is_named():
-    with pytest.raises(ValueError, match=r"time_budget_s = -1\.0+; it must be 0"):
-        fc.SolverOptions(time_budget_s=-1.0)
+@pytest.mark.parametrize("budget", [-1.0, math.inf, math.nan])
+def test_bad_work_budget_is_named(budget):
+    with pytest.raises(ValueError, match=r"work_budget_gflop = -?(1\.0+|inf|nan); it must be 0"):
+        fc.SolverOptions(work_budget_gflop=budget)
 
 
 def test_bad_increment_count(setup):

@@ -51,6 +51,7 @@ py::dict report_dict(const SolveReport& r)
   d["converged"] = r.converged;
   d["iterations"] = r.iterations;
   d["state_changes"] = r.state_changes;
+  d["work_gflop"] = r.work_gflop;
   d["residual"] = r.residual;
   d["cycled"] = r.cycled;
   d["attempts"] = r.attempts;
@@ -72,8 +73,10 @@ std::vector<bool> flags(const std::optional<BoolArray>& a)
 
 void raise_convergence_error(py::handle cls, const ConvergenceError& e)
 {
-  py::object error = cls(e.what());
+  const SavedProblem saved = save_failed_problem(e);
+  py::object error = cls(std::string(e.what()) + saved.note);
   error.attr("report") = report_dict(e.report);
+  error.attr("problem_path") = saved.path;
   PyErr_SetObject(cls.ptr(), error.ptr());
   throw py::error_already_set();
 }

@@ -8,6 +8,7 @@
 #include <flexcontact/increment.hpp>
 #include <flexcontact/pairs.hpp>
 #include <flexcontact/problem.hpp>
+#include <flexcontact/problem_file.hpp>
 #include <flexcontact/residual.hpp>
 #include <flexcontact/solvers.hpp>
 
@@ -15,6 +16,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -143,8 +145,10 @@ void bind_errors(py::module& m)
         {
           // The exception carries the best report as attribute `report`.
           py::object type = py::reinterpret_borrow<py::object>(convergence_error.ptr());
-          py::object inst = type(e.what());
+          const SavedProblem saved = save_failed_problem(e);
+          py::object inst = type(std::string(e.what()) + saved.note);
           inst.attr("report") = py::cast(e.report);
+          inst.attr("problem_path") = saved.path;
           PyErr_SetObject(convergence_error.ptr(), inst.ptr());
         }
       });
@@ -210,30 +214,32 @@ void bind_problem(py::module& m)
       .def(py::init<>())
       .def(py::init(
                [](double tolerance, int max_iterations, std::vector<std::string> chain,
-                  bool verbose, double time_budget_s)
+                  bool verbose, double work_budget_gflop)
                {
-                 if (!(time_budget_s >= 0.0))
-                   throw std::invalid_argument("SolverOptions: time_budget_s = "
-                                               + std::to_string(time_budget_s)
+                 if (!(work_budget_gflop >= 0.0) || !std::isfinite(work_budget_gflop))
+                   throw std::invalid_argument("SolverOptions: work_budget_gflop = "
+                                               + std::to_string(work_budget_gflop)
                                                + "; it must be 0 (automatic) or positive");
                  SolverOptions o;
                  o.tolerance = tolerance;
                  o.max_iterations = max_iterations;
                  o.chain = std::move(chain);
                  o.verbose = verbose;
-                 o.time_budget_s = time_budget_s;
+                 o.work_budget_gflop = work_budget_gflop;
                  return o;
                }),
            py::arg("tolerance") = 1e-10, py::arg("max_iterations") = 100,
            py::arg("chain") = std::vector<std::string>(), py::arg("verbose") = false,
-           py::arg("time_budget_s") = 0.0)
+           py::arg("work_budget_gflop") = 0.0)
       .def_readwrite("tolerance", &SolverOptions::tolerance)
       .def_readwrite("max_iterations", &SolverOptions::max_iterations)
       .def_readwrite("chain", &SolverOptions::chain)
       .def_readwrite("verbose", &SolverOptions::verbose)
-      .def_readwrite("time_budget_s", &SolverOptions::time_budget_s,
-                     "Wall-clock limit (s): a solver alone stops at it (0: none); the chain "
-                     "shares it among its attempts (0: chain_time_budget_s(n))")
+      .def_readwrite("work_budget_gflop", &SolverOptions::work_budget_gflop,
+                     "Work limit in Gflop, estimated from the sizes of the dense kernels (not "
+                     "time: the same answer under any load). A solver alone stops at it (0: "
+                     "none); the chain shares it among its attempts (0: "
+                     "chain_work_budget_gflop(n))")
       .def("__repr__",
            [](const SolverOptions& o)
            {
@@ -243,7 +249,7 @@ void bind_problem(py::module& m)
              for (std::size_t i = 0; i < o.chain.size(); ++i)
                s << (i ? ", " : "") << "'" << o.chain[i] << "'";
              s << "], verbose=" << (o.verbose ? "True" : "False")
-               << ", time_budget_s=" << o.time_budget_s << ")";
+               << ", work_budget_gflop=" << o.work_budget_gflop << ")";
              return s.str();
            });
 
@@ -256,6 +262,8 @@ void bind_problem(py::module& m)
       .def_readonly("solver", &SolveReport::solver)
       .def_readonly("iterations", &SolveReport::iterations)
       .def_readonly("state_changes", &SolveReport::state_changes)
+      .def_readonly("work_gflop", &SolveReport::work_gflop,
+                    "Estimated work done (Gflop): this solver's, or the whole chain's")
       .def_readonly("residual", &SolveReport::residual)
       .def_readonly("converged", &SolveReport::converged)
       .def_readonly("cycled", &SolveReport::cycled)
@@ -449,11 +457,29 @@ void bind_solvers(py::module& m)
       { return solve_newton_ac(p, l0, o); },
       "Semi-smooth Newton on the Alart-Curnier formulation");
 
+  m.def(
+      "write_local_problem",
+      [](const std::string& path, int dim, const Matrix& W, const Vector& q, const Vector& mu,
+         const std::optional<Vector>& lambda_start, const std::optional<IntArray>& states_start,
+         const SolverOptions& options, const std::optional<Vector>& cap,
+         const std::string& source)
+      {
+        LocalProblem p{dim, W, q, mu, or_empty(cap), or_empty(lambda_start),
+                       states_from(states_start), options, source};
+        check_problem(dim, W, q, mu, p.lambda_start, p.states_start.size());
+        cap_pointer(cap, q, dim);
+        write_local_problem(path, p);
+      },
+      py::arg("path"), py::arg("dim"), py::arg("W"), py::arg("q"), py::arg("mu"),
+      py::arg("lambda_start") = py::none(), py::arg("states_start") = py::none(),
+      py::arg("options") = SolverOptions(), py::arg("cap") = py::none(),
+      py::arg("source") = "",
+      "Writes one local problem in format 3 of docs/solvers.md");
   m.def("solver_names", &solver_names, "Names accepted in SolverOptions.chain");
   m.def("default_chain", &default_chain, "Default solver order, most robust first");
-  m.def("chain_time_budget_s", &chain_time_budget_s, py::arg("n"),
-        "The chain's wall-clock budget (s) for n unknowns when time_budget_s is 0: "
-        "10 + 10 (n/1000)^3");
+  m.def("chain_work_budget_gflop", &chain_work_budget_gflop, py::arg("n"),
+        "The chain's work budget (Gflop) for n unknowns when work_budget_gflop is 0 "
+        "(docs/solvers.md)");
 }
 
 /// @brief increment.hpp: the incremental driver.
@@ -504,4 +530,5 @@ void flexcontact::bind_kernel(py::module& m)
   bind_increment(m);
   bind_condensed(m);
   bind_impact(m);
+  bind_problem_file(m);
 }

@@ -38,6 +38,8 @@ void bind_operator(pybind11::module& m);
 
 /// @brief The Moreau–Jean contact step (kernel/.../impact.hpp).
 void bind_impact(pybind11::module& m);
+/// @brief problem_file.hpp: LocalProblem, read_local_problem.
+void bind_problem_file(pybind11::module& m);
 
 // Conversions shared by the step bindings (bind_convert.cpp): what crosses back to Python is
 // plain NumPy and dicts, picklable so that rank 0 can broadcast it.
@@ -56,6 +58,16 @@ pybind11::dict condensed_step_dict(const struct CondensedStep& r, int dim);
 
 /// @brief What a solver did, as a dict.
 pybind11::dict report_dict(const SolveReport& r);
+
+/// @brief A failing problem saved (flexcontact.problem_files.save_failed): the text added to
+/// the error's message (empty if the error carries no problem), and the path (None if
+/// none was saved).
+struct SavedProblem
+{
+  std::string note;
+  pybind11::object path;
+};
+SavedProblem save_failed_problem(const ConvergenceError& e);
 
 /// @brief Raises `e` in Python as the module's ConvergenceError `cls`, its report attached as
 /// a plain dict (attribute `report`), like a step's result.

@@ -8,7 +8,6 @@
 #include "flexcontact/problem.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -16,35 +15,6 @@
 
 namespace flexcontact::detail
 {
-/// @brief The wall-clock limit of SolverOptions::time_budget_s, started at construction;
-/// a budget of 0 (or less) never passes.
-class Deadline
-{
-public:
-  explicit Deadline(double budget_s)
-      : limited_{budget_s > 0.0},
-        end_{std::chrono::steady_clock::now()
-             + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                 std::chrono::duration<double>(limited_ ? budget_s : 0.0))}
-  {
-  }
-
-  bool passed() const { return limited_ && std::chrono::steady_clock::now() >= end_; }
-
-  /// @brief Seconds left (a large number when unlimited, 0 once passed).
-  double left_s() const
-  {
-    if (!limited_)
-      return 1e300;
-    const std::chrono::duration<double> left = end_ - std::chrono::steady_clock::now();
-    return std::max(left.count(), 0.0);
-  }
-
-private:
-  bool limited_;
-  std::chrono::steady_clock::time_point end_;
-};
-
 /// @brief Alart–Curnier function of one pair, Φ = λ − P(λ − ρ u) in the non-De Saxcé form:
 /// normal λ_n − max(0, z_n); tangent λ_t − P_disc(μ max(0, z_n))(z_t), z = λ − ρ u.
 /// If dP is non-null it receives ∂P/∂z (d×d, row-major), one element of the generalised

@@ -9,6 +9,7 @@
 #include "flexcontact/solvers.hpp"
 
 #include "ac_pair.hpp"
+#include "work_meter.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -445,9 +446,11 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
 
   Matrix A(n, n);
   Vector b(n), x(n);
-  const detail::Deadline deadline(opt.time_budget_s);
-  while (rep.iterations < opt.max_iterations && !deadline.passed())
+  detail::WorkMeter work(opt.work_budget_gflop);
+  while (rep.iterations < opt.max_iterations && !work.spent())
   {
+    // The modified system (copied from W) and its LU, then u = W λ + q.
+    work.charge(detail::lu_flops(n) + 2.0 * detail::product_flops(n));
     build_modified_system(p, states, crush_slip, dir, c, A, b);
     ++rep.iterations;
     if (!solve_dense(A, b, x))
@@ -491,6 +494,7 @@ SolveReport solve_active_set(const ProblemView& p, const Eigen::Ref<const Vector
   }
 
   finish_report(p, best_lambda, opt.tolerance, rep);
+  rep.work_gflop = work.used_gflop();
   return rep;
 }
 } // namespace flexcontact

@@ -216,7 +216,9 @@ void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
                        + ") from " + rep.solver + ". Tried:";
     for (const auto& a : rep.attempts)
       what += " [" + a + "]";
-    throw ConvergenceError(what, std::move(rep));
+    throw ConvergenceError(what, std::move(rep),
+                           std::make_shared<const LocalProblem>(LocalProblem{
+                               d, W, q, mu, cap, P0, s0, options_, "ImpactSolver: time step"}));
   }
   for (Eigen::Index a = 0; a < n; ++a)
     r.impulse[idx[a]] = rep.lambda[a];

@@ -185,18 +185,24 @@ const SolveReport& IncrementalSolver::step(const Eigen::Ref<const Vector>& q_tot
                             : solve(view, lambda_, states_, options_);
   if (!r.converged)
   {
+    // What the chain was given, to be saved for a bug report (bordered problems excepted:
+    // the file has no place for the rigid modes).
+    std::shared_ptr<const LocalProblem> given;
+    if (G_.cols() == 0)
+      given = std::make_shared<const LocalProblem>(LocalProblem{
+          dim_, W_, q, mu_, cap_, lambda_, states_, options_, "IncrementalSolver::step"});
     // A load the capped forces cannot carry has no answer to converge to: say that first.
     if (r.attempts.size() == 1 && r.attempts.front().rfind("no equilibrium", 0) == 0)
     {
       const std::string what = "flexcontact: " + r.attempts.front();
-      throw ConvergenceError(what, std::move(r));
+      throw ConvergenceError(what, std::move(r), std::move(given));
     }
     std::string what = "flexcontact: increment did not converge; best residual "
                        + num(r.residual) + " (tolerance " + num(options_.tolerance)
                        + ") from " + r.solver + ". Tried:";
     for (const auto& a : r.attempts)
       what += " [" + a + "]";
-    throw ConvergenceError(what, std::move(r));
+    throw ConvergenceError(what, std::move(r), std::move(given));
   }
   x_ = W_ * r.lambda + q_total;
   if (G_.cols())

@@ -8,6 +8,7 @@
 
 #include "ac_pair.hpp"
 #include "newton_step.hpp"
+#include "work_meter.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -151,7 +152,7 @@ public:
         dP_(static_cast<std::size_t>(p.pairs()) * p.dim * p.dim),
         f_(detail::merit(p, rho_.normal, rho_.tangential, lam_, u_, phi_, dP_)),
         res_(natural_map_residual(p, lam_, u_, rho_.residual)), history_(f_),
-        progress_(res_, lam_)
+        progress_(res_, lam_), work_(opt.work_budget_gflop)
   {
     closed_.reserve(p.pairs());
   }
@@ -161,6 +162,7 @@ public:
 private:
   bool globalised_step();
   bool gauss_seidel_restart();
+  void charge_step();
   void take_trial();
 
   const ProblemView& p_;
@@ -175,6 +177,7 @@ private:
   double res_; ///< natural-map residual at λ
   detail::MeritHistory history_;
   Progress progress_;
+  detail::WorkMeter work_;
   int it_ = 0, sweeps_used_ = 0, full_steps_ = 0;
 };
 
@@ -183,16 +186,16 @@ SolveReport NewtonRun::run()
   const long maxit
       = static_cast<long>(opt_.max_iterations) * std::max(settings_.iteration_factor, 1);
   std::string why;
-  const detail::Deadline deadline(opt_.time_budget_s);
   while (res_ > opt_.tolerance && it_ < maxit)
   {
-    if (deadline.passed())
+    if (work_.spent())
     {
-      why = ", time budget spent";
+      why = ", work budget spent";
       break;
     }
     ++it_;
     detail::closed_pairs(dP_, p_.pairs(), p_.dim, closed_);
+    charge_step();
     if (!detail::newton_direction(p_, rho_.normal, rho_.tangential, phi_, dP_, closed_, dl_))
     {
       why = ", linear system not solvable";
@@ -220,6 +223,7 @@ SolveReport NewtonRun::run()
   SolveReport rep;
   rep.solver = "newton_ac";
   finish_report(p_, lam_, it_, sweeps_used_, why, opt_.tolerance, rep);
+  rep.work_gflop = work_.used_gflop();
   return rep;
 }
 
@@ -247,6 +251,8 @@ bool NewtonRun::globalised_step()
 bool NewtonRun::gauss_seidel_restart()
 {
   ++sweeps_used_;
+  // Five sweeps at most, each a pass over W's columns and a fresh u.
+  work_.charge(5.0 * 2.0 * detail::product_flops(static_cast<double>(p_.q.size())));
   gauss_seidel_sweeps(p_, rho_.residual, opt_.tolerance, lam_, u_, res_);
   if (!lam_.allFinite())
     return false;
@@ -256,6 +262,15 @@ bool NewtonRun::gauss_seidel_restart()
   if (opt_.verbose)
     std::fprintf(stderr, "newton_ac it %d: Gauss-Seidel sweeps, residual %.3e\n", it_, res_);
   return true;
+}
+
+/// @brief One Newton step's work: W Δ₀ and W Δ (two products with W), the closed block
+/// (d flops per entry of each d×d product) and its LU.
+void NewtonRun::charge_step()
+{
+  const double n = static_cast<double>(p_.q.size());
+  const double s = static_cast<double>(closed_.size()) * p_.dim;
+  work_.charge(2.0 * detail::product_flops(n) + 2.0 * p_.dim * s * s + detail::lu_flops(s));
 }
 
 /// @brief Moves to the accepted trial iterate and evaluates Φ, the merit and the residual.

@@ -304,7 +304,9 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
         ProblemView{dim, r.W, r.q, r.mu, r.cap.size() ? r.cap.data() : nullptr}, r.lambda,
         r.states, opt);
     inner += rep.iterations;
-    if (same) // the chain stops on a wall-clock budget: all ranks must agree on its outcome
+    // The chain is budgeted in work, so equal data give equal outcomes; the ranks still
+    // compare before the collective solves that follow, which must not part ways.
+    if (same)
       same(rep.converged ? static_cast<long>(A.size()) : -1L);
     out.lambda.setZero();
     for (std::size_t a = 0; a < A.size(); ++a)

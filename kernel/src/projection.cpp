@@ -9,6 +9,7 @@
 #include "flexcontact/solvers.hpp"
 
 #include "ac_pair.hpp"
+#include "work_meter.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -344,15 +345,17 @@ SolveReport solve_projection(const ProblemView& p, const Eigen::Ref<const Vector
   long sweep = 0;
   int fallbacks = 0;
   std::string why;
-  const detail::Deadline deadline(opt.time_budget_s);
+  detail::WorkMeter work(opt.work_budget_gflop);
   while (res > opt.tolerance && sweep < max_sweeps)
   {
-    if (deadline.passed())
+    if (work.spent())
     {
-      why = ", time budget spent";
+      why = ", work budget spent";
       break;
     }
     ++sweep;
+    // A sweep passes once over W's columns (u += δ W_j for each unknown that moved).
+    work.charge(detail::product_flops(n));
     fallbacks += detail::nsgs_sweep(p, rho, lam, u);
     if (!lam.allFinite())
     {
@@ -376,6 +379,7 @@ SolveReport solve_projection(const ProblemView& p, const Eigen::Ref<const Vector
   rep.residual = natural_map_residual(p, rep.lambda);
   rep.converged = rep.residual <= opt.tolerance;
   rep.states = classify_states(p, rep.lambda, rep.u);
+  rep.work_gflop = work.used_gflop();
   if (fallbacks > 0)
     why += ", " + std::to_string(fallbacks) + " degenerate local solves";
   rep.attempts.push_back("projection: " + std::string(rep.converged ? "converged" : "not converged")

@@ -20,10 +20,21 @@ namespace flexcontact
 {
 std::vector<std::string> solver_names() { return {"active_set", "projection", "newton_ac"}; }
 
-double chain_time_budget_s(long n)
+namespace
+{
+// docs/solvers.md, "The work budget": the constant is more than every solver of the chain
+// can do within its iteration caps below 200 unknowns (36 Gflop there), so a small problem
+// never stops on work; the cubic term is 300 LU factorisations of the whole n × n matrix.
+// On the reference machine (19 Gflop/s on large problems, 2–9 on small ones) they match
+// the wall-clock budget they replaced, 10 s + 10 s·(n/1000)³.
+constexpr double chain_work_constant_gflop = 50.0;
+constexpr double chain_work_cubic_gflop = 200.0;
+} // namespace
+
+double chain_work_budget_gflop(long n)
 {
   const double k = static_cast<double>(std::max(n, 0L)) / 1000.0;
-  return 10.0 + 10.0 * k * k * k;
+  return chain_work_constant_gflop + chain_work_cubic_gflop * k * k * k;
 }
 
 std::vector<std::string> default_chain()
@@ -144,7 +155,7 @@ SolveReport run_solver(const std::string& name, const ProblemView& p, const Vect
   return r;
 }
 
-/// @brief One run of the chain: the best answer so far, the attempts' lines, and the time
+/// @brief One run of the chain: the best answer so far, the attempts' lines, and the work
 /// budget that the attempts share.
 class ChainRun
 {
@@ -152,8 +163,8 @@ public:
   ChainRun(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
            const std::vector<PairState>& states0, const SolverOptions& opt)
       : p_(p), lambda0_(lambda0), states0_(states0), opt_(opt),
-        budget_s_(opt.time_budget_s > 0.0 ? opt.time_budget_s : chain_time_budget_s(p.q.size())),
-        deadline_(budget_s_)
+        budget_gflop_(opt.work_budget_gflop > 0.0 ? opt.work_budget_gflop
+                                                  : chain_work_budget_gflop(p.q.size()))
   {
   }
 
@@ -162,7 +173,7 @@ public:
 private:
   bool solved() const { return have_best_ && best_.converged; }
   SolverOptions left() const;
-  bool out_of_time();
+  bool out_of_work();
   void projection_warm_start();
   void from_two_starts(const std::string& name);
   void newton_variants_from_zero();
@@ -174,8 +185,8 @@ private:
   const Eigen::Ref<const Vector>& lambda0_;
   const std::vector<PairState>& states0_;
   const SolverOptions& opt_;
-  const double budget_s_;
-  const detail::Deadline deadline_;
+  const double budget_gflop_;
+  double used_gflop_ = 0.0;
   std::vector<std::string> attempts_;
   SolveReport best_;
   bool have_best_ = false;
@@ -210,27 +221,29 @@ SolveReport ChainRun::run(const std::vector<std::string>& chain)
       best_.converged = false;
   }
   best_.attempts = std::move(attempts_);
+  best_.work_gflop = used_gflop_;
   return std::move(best_);
 }
 
-/// @brief The options of the next attempt: what is left of the chain's budget.
+/// @brief The options of the next attempt: what is left of the chain's budget (never 0,
+/// which would mean none).
 SolverOptions ChainRun::left() const
 {
   SolverOptions o = opt_;
-  o.time_budget_s = std::max(deadline_.left_s(), 1e-9);
+  o.work_budget_gflop = std::max(budget_gflop_ - used_gflop_, 1e-12);
   return o;
 }
 
 /// @brief True once the budget is spent; the first time, says so in `attempts`.
-bool ChainRun::out_of_time()
+bool ChainRun::out_of_work()
 {
-  if (!deadline_.passed())
+  if (used_gflop_ < budget_gflop_)
     return false;
   if (!budget_noted_)
   {
     char buf[96];
-    std::snprintf(buf, sizeof buf, "time budget of %.3g s spent: no further attempts",
-                  budget_s_);
+    std::snprintf(buf, sizeof buf, "work budget of %.3g Gflop spent: no further attempts",
+                  budget_gflop_);
     attempts_.emplace_back(buf);
     budget_noted_ = true;
   }
@@ -246,6 +259,7 @@ void ChainRun::projection_warm_start()
   SolverOptions warm = left();
   warm.max_iterations = 1; // the projection solver runs 50 × max_iterations sweeps
   best_ = solve_projection(p_, lambda0_, warm);
+  used_gflop_ += best_.work_gflop;
   best_.solver = "projection";
   attempts_.push_back(attempt_line(best_) + " (warm start)");
   if (opt_.verbose)
@@ -269,7 +283,7 @@ void ChainRun::from_two_starts(const std::string& name)
   {
     if (attempt == 1 && !had_best)
       break; // both starts would be the caller's
-    if (out_of_time())
+    if (out_of_work())
       break;
     const bool warm = had_best && (attempt == 0) == warm_first;
     SolveReport r = run_solver(name, p_, warm ? best_.lambda : Vector(lambda0_),
@@ -286,7 +300,7 @@ void ChainRun::from_two_starts(const std::string& name)
 void ChainRun::newton_polish(const std::vector<std::string>& chain)
 {
   if (!have_best_ || best_.converged || best_.solver == "newton_ac"
-      || std::find(chain.begin(), chain.end(), "newton_ac") == chain.end() || out_of_time())
+      || std::find(chain.begin(), chain.end(), "newton_ac") == chain.end() || out_of_work())
     return;
   SolveReport r = run_solver("newton_ac", p_, best_.lambda, best_.states, left(), false);
   keep_best(std::move(r), " (from the best so far, last)");
@@ -296,7 +310,7 @@ void ChainRun::newton_variants_from_zero()
 {
   for (const auto& variant : newton_variants)
   {
-    if (solved() || out_of_time())
+    if (solved() || out_of_work())
       break;
     SolveReport r = detail::newton_ac(p_, Vector::Zero(p_.q.size()), left(), variant.settings);
     r.solver = "newton_ac";
@@ -307,6 +321,7 @@ void ChainRun::newton_variants_from_zero()
 /// @brief Records r's attempt line (how: its start) and keeps r as the best answer if it is.
 void ChainRun::keep_best(SolveReport&& r, const std::string& how)
 {
+  used_gflop_ += r.work_gflop;
   attempts_.push_back(attempt_line(r) + how);
   if (opt_.verbose)
     std::cerr << "solve: " << attempts_.back() << "\n";
@@ -334,10 +349,10 @@ SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
 {
   const std::vector<std::string> chain = opt.chain.empty() ? default_chain() : opt.chain;
   check_chain(chain);
-  if (!(opt.time_budget_s >= 0.0) || !std::isfinite(opt.time_budget_s))
-    throw std::invalid_argument("flexcontact: solver options: time_budget_s = "
-                                + std::to_string(opt.time_budget_s)
-                                + "; it must be 0 (automatic) or a positive number of seconds");
+  if (!(opt.work_budget_gflop >= 0.0) || !std::isfinite(opt.work_budget_gflop))
+    throw std::invalid_argument("flexcontact: solver options: work_budget_gflop = "
+                                + std::to_string(opt.work_budget_gflop)
+                                + "; it must be 0 (automatic) or a positive number of Gflop");
 
   return ChainRun(p, lambda0, states0, opt).run(chain);
 }

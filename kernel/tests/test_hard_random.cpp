@@ -118,14 +118,14 @@ INSTANTIATE_TEST_SUITE_P(LostBefore, HardRandom,
                            return n;
                          });
 
-TEST(ChainBudget, StopsOnceTheTimeBudgetIsSpentAndSaysSo)
+TEST(ChainBudget, StopsOnceTheWorkBudgetIsSpentAndSaysSo)
 {
-  // A budget already spent at the first check: the chain must not try on, and must return
-  // an honest unconverged report (finite λ, its true residual) rather than throw or hang.
+  // A budget spent by the first step: the chain must not try on, and must return an honest
+  // unconverged report (finite λ, its true residual) rather than throw or hang.
   const Stored s = read_stored("ill_conditioned-3d-m12-5591");
   const ProblemView p{s.dim, s.W, s.q, s.mu};
   SolverOptions opt;
-  opt.time_budget_s = 1e-9;
+  opt.work_budget_gflop = 1e-9;
   const SolveReport r = solve(p, Vector(), {}, opt);
   EXPECT_FALSE(r.converged);
   ASSERT_EQ(r.lambda.size(), s.q.size());
@@ -133,14 +133,36 @@ TEST(ChainBudget, StopsOnceTheTimeBudgetIsSpentAndSaysSo)
   EXPECT_DOUBLE_EQ(r.residual, natural_map_residual(p, r.lambda));
   EXPECT_GT(r.residual, opt.tolerance);
   ASSERT_FALSE(r.attempts.empty());
-  EXPECT_NE(r.attempts.back().find("time budget"), std::string::npos) << r.attempts.back();
+  EXPECT_NE(r.attempts.back().find("work budget"), std::string::npos) << r.attempts.back();
+}
+
+TEST(ChainBudget, ABudgetCutsTheChainAtTheSameIterateEveryTime)
+{
+  // Work depends on the path only: cut half way, two runs end on the same λ, bitwise, with
+  // the same attempts. (tests/test_bad_input.py repeats this beside a CPU hog.)
+  const Stored s = read_stored("ill_conditioned-3d-m36-3407");
+  const ProblemView p{s.dim, s.W, s.q, s.mu};
+  const SolveReport full = solve(p, Vector(), {}, SolverOptions{});
+  ASSERT_TRUE(full.converged);
+  SolverOptions opt;
+  opt.work_budget_gflop = 0.5 * full.work_gflop;
+  const SolveReport a = solve(p, Vector(), {}, opt);
+  const SolveReport b = solve(p, Vector(), {}, opt);
+  EXPECT_EQ(a.attempts, b.attempts);
+  EXPECT_EQ(a.work_gflop, b.work_gflop);
+  ASSERT_EQ(a.lambda.size(), b.lambda.size());
+  for (Eigen::Index i = 0; i < a.lambda.size(); ++i)
+    ASSERT_EQ(a.lambda(i), b.lambda(i)) << "component " << i;
+  // The cut run spent its budget (within one iteration's work) and did not go on.
+  EXPECT_GE(a.work_gflop, opt.work_budget_gflop);
+  EXPECT_LT(a.work_gflop, full.work_gflop);
 }
 
 TEST(ChainBudget, AutomaticBudgetGrowsWithTheCubeOfTheSize)
 {
-  // 10 s + 10 s (n/1000)³, as documented in problem.hpp.
-  EXPECT_DOUBLE_EQ(chain_time_budget_s(0), 10.0);
-  EXPECT_DOUBLE_EQ(chain_time_budget_s(1000), 20.0);
-  EXPECT_DOUBLE_EQ(chain_time_budget_s(3000), 280.0);
+  // 50 Gflop + 200 Gflop·(n/1000)³, as documented in problem.hpp.
+  EXPECT_DOUBLE_EQ(chain_work_budget_gflop(0), 50.0);
+  EXPECT_DOUBLE_EQ(chain_work_budget_gflop(1000), 250.0);
+  EXPECT_DOUBLE_EQ(chain_work_budget_gflop(3000), 5450.0);
 }
 } // namespace

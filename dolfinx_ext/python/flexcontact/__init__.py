@@ -24,6 +24,7 @@ from .rigid import RigidTarget
 from .floating import FreeModeWarning, NoEquilibriumError, TippingWarning
 from .dynamics import ImpactProblem, ImpactStepRecord
 from .memory import ContactMemoryError
+from .problem_files import load_problem
 
 __version__ = "0.1.0"
 
@@ -37,5 +38,5 @@ __all__ = [
     "FlexcontactError", "InputError", "InputTypeError", "SolveError",
     "ConvergenceError", "SingularStiffnessError", "MumpsError", "PetscError",
     "NoEquilibriumError", "FreeModeWarning", "TippingWarning", "ContactMemoryError",
-    "__version__",
+    "load_problem", "__version__",
 ]

@@ -175,7 +175,9 @@ class Stepper:
             if root and "local_q" in out:
                 self.last_local_q = np.asarray(out["local_q"])
         except ConvergenceError as err:
-            failure = (f"{where}: {err}", dict(getattr(err, "report", {})), False)
+            report = dict(getattr(err, "report", {}))
+            report["problem_path"] = getattr(err, "problem_path", None)
+            failure = (f"{where}: {err}", report, False)
             if on_failure is not None and root:
                 failure = on_failure(failure)
             if root and hasattr(kernel, "local_q") and hasattr(kernel, "last_q"):
@@ -301,6 +303,7 @@ class BodiesStepper:
         except ConvergenceError as err:
             error = ConvergenceError(f"{where}: {err}")
             error.report = dict(getattr(err, "report", {}))
+            error.problem_path = getattr(err, "problem_path", None)
             raise error from None
         self.crossings += 1
         key = self.expand_key if split else "reaction"
@@ -395,4 +398,6 @@ def _raise(failure: Failure):
         raise InputError(message)
     error = (NoEquilibriumError if no_equilibrium else ConvergenceError)(message)
     error.report = report  # what the solvers did, on every rank
+    # The saved local problem (problem_files.py), named in the message; None if none was.
+    error.problem_path = report.get("problem_path")
     raise error

@@ -6,6 +6,8 @@
 /// time step, friction path dependent through the previous tangential gap.
 
 #include "flexcontact/problem.hpp"
+#include "flexcontact/problem_file.hpp"
+#include <memory>
 #include <stdexcept>
 
 namespace flexcontact
@@ -95,11 +97,17 @@ private:
 };
 
 /// @brief Thrown when no local solver converged; what() names solvers, iterations, residual.
+/// `problem`, where the failure was one call of solve(), is what that call was given: the
+/// bindings save it as a file a user can send (problem_file.hpp).
 class ConvergenceError : public std::runtime_error
 {
 public:
-  ConvergenceError(const std::string& what, SolveReport report)
-      : std::runtime_error(what), report(std::move(report)) {}
+  ConvergenceError(const std::string& what, SolveReport report,
+                   std::shared_ptr<const LocalProblem> problem = nullptr)
+      : std::runtime_error(what), report(std::move(report)), problem(std::move(problem))
+  {
+  }
   SolveReport report;
+  std::shared_ptr<const LocalProblem> problem;
 };
 } // namespace flexcontact

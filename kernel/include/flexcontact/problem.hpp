@@ -86,20 +86,22 @@ struct SolverOptions
   std::vector<std::string> chain;
   /// Print one line per iteration to stderr (debugging).
   bool verbose = false;
-  /// Wall-clock limit in seconds. A solver alone stops (converged=false, its best iterate)
-  /// at its first check past it; 0 means no limit. The chain (solve()) shares it among its
-  /// attempts and stops trying once it has passed; there 0 means the automatic budget
-  /// chain_time_budget_s() of the problem's size.
-  double time_budget_s = 0.0;
+  /// Work limit, in billions of floating-point operations estimated from the sizes of each
+  /// iteration's dense kernels (docs/solvers.md, "The work budget"). A solver alone stops
+  /// (converged=false, its best iterate) at its first check past it; 0 means no limit. The
+  /// chain (solve()) shares it among its attempts and stops trying once it is spent; there
+  /// 0 means the automatic budget chain_work_budget_gflop() of the problem's size. Work,
+  /// not time: the same input stops at the same iterate on a quiet and on a loaded machine.
+  double work_budget_gflop = 0.0;
 };
 
-/// @brief The chain's wall-clock budget when SolverOptions::time_budget_s is 0, for n
-/// unknowns: 10 s + 10 s · (n / 1000)³ (10.06 s at 180 unknowns, 20 s at 1,000, 280 s at
-/// 3,000). The cubic term is about 30 dense factorisations of the Newton matrix on one
-/// core; the constant lets the hardest small problems use the ~1,000 damped Newton steps
-/// they need (condition numbers near 1e10) and still leaves the projection its turn: with
-/// 3 s, 8 of 6,000 random problems that the projection alone solves in 4–6 s were lost.
-double chain_time_budget_s(long n);
+/// @brief The chain's work budget when SolverOptions::work_budget_gflop is 0, for n
+/// unknowns: 50 + 200·(n/1000)³ Gflop (docs/solvers.md, "The work budget"). The cubic term
+/// is 300 dense LU factorisations of the whole n × n Newton matrix; the constant is more
+/// than the chain can spend within its iteration caps below 200 unknowns, so the hardest
+/// small problems (condition numbers near 1e10) keep the thousands of damped Newton steps
+/// they need in all the chain's variants, and the projection its turn.
+double chain_work_budget_gflop(long n);
 
 /// @brief What a local solver did and found.
 struct SolveReport
@@ -110,6 +112,9 @@ struct SolveReport
   std::string solver;               ///< name of the solver whose answer this is
   int iterations = 0;               ///< iterations of that solver
   int state_changes = 0;            ///< pair state switches (active set), 0 for others
+  /// Estimated work done, in Gflop (WorkMeter, docs/solvers.md): this solver's, or for solve()
+  /// the whole chain's.
+  double work_gflop = 0.0;
   double residual = std::numeric_limits<double>::infinity(); ///< relative natural-map residual
   bool converged = false;
   bool cycled = false;              ///< active set revisited an earlier state vector

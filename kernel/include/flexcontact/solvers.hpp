@@ -76,9 +76,10 @@ std::vector<std::string> default_chain();
 /// steps: Siconos' globalisation (full step where the line search fails) with each pair's
 /// ρ = 1/‖W_kk‖₂ and a Goldstein–Price search, the same with Armijo's search, Armijo's
 /// with the normal/tangential ρ, and the restarted Newton with the block ρ; they solve
-/// different subsets of the hard problems. The whole chain stops trying once opt.time_budget_s (0:
-/// chain_time_budget_s(n), 10 s + 10 s·(n/1000)³) has passed, with a line in `attempts`;
-/// each attempt also stops at it. The report is the converging solver's, with `attempts`
+/// different subsets of the hard problems. The whole chain stops trying once the work of
+/// opt.work_budget_gflop (0: chain_work_budget_gflop(n), 50 + 200·(n/1000)³ Gflop) is
+/// spent, with a line in `attempts`; each attempt also stops at it. Work, not time: the
+/// same input gives the bitwise same answer on a quiet and on a loaded machine. The report is the converging solver's, with `attempts`
 /// listing every try; if none converges it is the best one's (smallest residual) with
 /// converged=false.
 SolveReport solve(const ProblemView& p, const Eigen::Ref<const Vector>& lambda0,
