@@ -6,8 +6,8 @@ stress per unit thickness) at v = 1 m/s against a wall held by Dirichlet conditi
 end crushable at σ_c = ratio × ρ c v; the end's nodes are the slave of a node–node
 interface with the wall.
 
-Run: ``/usr/bin/python3 tests/crush_bar_case.py RATIO N OUT.npz`` (also under mpirun): writes
-the step times, forces, crushing pairs, crush depth and energies.
+Run: ``/usr/bin/python3 tests/crush_bar_case.py RATIO N OUT.npz [dense|factor]`` (also under
+mpirun): writes the step times, forces, crushing pairs, crush depth and energies.
 """
 import math
 import sys
@@ -38,7 +38,8 @@ def exact(ratio):
     return dict(s=s, N=N, u_N=u_N, delta=delta, duration=duration)
 
 
-def run(ratio, n, crushing=True, comm=MPI.COMM_WORLD, extra_periods=2.0, courant=COURANT):
+def run(ratio, n, crushing=True, comm=MPI.COMM_WORLD, extra_periods=2.0, courant=COURANT,
+        contact_operator="dense"):
     """Run the impact; returns a dict of arrays (same on every rank)."""
     msh, cells, facets, _ = bar_impact.build(comm, n=n, ny=1, target="wall")
     V = compat.vector_space(msh)
@@ -49,7 +50,8 @@ def run(ratio, n, crushing=True, comm=MPI.COMM_WORLD, extra_periods=2.0, courant
     dt = courant * (L / n) / C
     p = fc.ImpactProblem(V, cells, {"wall": BASE, "bar": UPPER}, {BASE: steel, UPPER: steel},
                          fc.hold_body(V, cells, BASE), itf, dt_s=dt,
-                         initial_velocity={"bar": (-V0, 0.0)}, kind="plane_stress")
+                         initial_velocity={"bar": (-V0, 0.0)}, kind="plane_stress",
+                         contact_operator=contact_operator)
     ex = exact(ratio)
     recs = p.run(ex["duration"] + extra_periods * 2 * L / C, progress=False)
     hist = p.energy.history
@@ -69,6 +71,7 @@ def run(ratio, n, crushing=True, comm=MPI.COMM_WORLD, extra_periods=2.0, courant
 
 
 if __name__ == "__main__":
-    out = run(float(sys.argv[1]), int(sys.argv[2]))
+    out = run(float(sys.argv[1]), int(sys.argv[2]),
+              contact_operator=sys.argv[4] if len(sys.argv) > 4 else "dense")
     if MPI.COMM_WORLD.rank == 0:
         np.savez(sys.argv[3], **out)

@@ -8,6 +8,7 @@
 /// plain dict of NumPy arrays and numbers.
 
 #include "bindings.h"
+#include "factor_operator.h"
 
 #include <flexcontact/impact.hpp>
 #include <flexcontact/increment.hpp>
@@ -16,6 +17,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
+#include <memory>
 #include <optional>
 
 namespace py = pybind11;
@@ -56,6 +59,27 @@ py::dict step_dict(const ImpactStep& r, int dim)
     d["velocity_c"] = py::array_t<double>(r.velocity_c.size(), r.velocity_c.data());
   }
   return d;
+}
+
+using DofArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+
+/// @brief The factor path's impact object with the PETSc operator it calls, kept alive
+/// together.
+struct FactorImpact
+{
+  std::shared_ptr<FactorFlexibility> flexibility;
+  std::unique_ptr<ImpactContact> contact;
+};
+
+std::shared_ptr<FactorFlexibility> factor_flexibility(std::uintptr_t factor_handle,
+                                                      std::uintptr_t A_handle,
+                                                      const DofArray& dofs, int n_virtual)
+{
+  // petsc4py's handles (Mat.handle), as for FactorContact.
+  std::vector<PetscInt> d(dofs.data(), dofs.data() + dofs.size());
+  return std::make_shared<FactorFlexibility>(reinterpret_cast<Mat>(factor_handle),
+                                             reinterpret_cast<Mat>(A_handle), std::move(d),
+                                             n_virtual);
 }
 } // namespace
 
@@ -135,4 +159,85 @@ void flexcontact::bind_impact(py::module& m)
       .def("pairs", &ImpactContact::pairs)
       .def("contact_dofs", &ImpactContact::contact_dofs)
       .def("dim", &ImpactContact::dim);
+
+  py::class_<FactorImpact>(
+      m, "FactorImpact",
+      "The factor path of the Moreau-Jean contact step: Fhat applied through the factor of "
+      "What by blocks of right-hand sides, W_eff's columns of the index set fetched and held; "
+      "neither Fhat nor W_eff is formed. Collective: build and step it on every rank with the "
+      "same arguments.")
+      .def(py::init(
+               [](int dim, std::uintptr_t factor, std::uintptr_t What, const DofArray& dofs,
+                  int n_virtual, Matrix X, std::vector<ContactPair> pairs, Vector mu, double e,
+                  double dt, double theta, const std::optional<BoolArray>& held,
+                  const SolverOptions& options, double max_bytes)
+               {
+                 FactorImpact c;
+                 c.flexibility = factor_flexibility(factor, What, dofs, n_virtual);
+                 auto F = c.flexibility;
+                 c.contact = std::make_unique<ImpactContact>(
+                     dim, [F](const Matrix& R) { return F->block(R); }, std::move(X),
+                     std::move(pairs), std::move(mu), e, dt, theta, flags(held), options,
+                     max_bytes);
+                 return c;
+               }),
+           py::arg("dim"), py::arg("factor"), py::arg("What"), py::arg("dofs"),
+           py::arg("n_virtual"), py::arg("X"), py::arg("pairs"), py::arg("mu"),
+           py::arg("restitution"), py::arg("dt_s"), py::arg("theta") = 0.5,
+           py::arg("constrained") = py::none(), py::arg("options") = SolverOptions(),
+           py::arg("working_set_bytes") = 0.0,
+           "factor, What: petsc4py Mat.handle of the factored What and of What (for its "
+           "layout); dofs: global indices of the real contact DOFs (the same on every rank); "
+           "working_set_bytes: memory for W_eff's columns of the index set")
+      .def(
+          "step",
+          [convergence_error](FactorImpact& c, const Vector& u_c, const Vector& v_c,
+                              const Vector& vfree_c)
+          {
+            const ImpactStep r = step_or_raise(convergence_error,
+                                               [&] { return c.contact->step(u_c, v_c, vfree_c); });
+            return step_dict(r, c.contact->dim());
+          },
+          py::arg("u_c"), py::arg("v_c"), py::arg("vfree_c"),
+          "As ImpactContact.step (v_free from a full solve). Collective.")
+      .def(
+          "set_flexibility",
+          [](FactorImpact& c, std::uintptr_t factor, std::uintptr_t What, const DofArray& dofs,
+             int n_virtual, double dt)
+          {
+            auto F = factor_flexibility(factor, What, dofs, n_virtual);
+            c.contact->set_block_flexibility([F](const Matrix& R) { return F->block(R); }, dt);
+            c.flexibility = F;
+          },
+          py::arg("factor"), py::arg("What"), py::arg("dofs"), py::arg("n_virtual"),
+          py::arg("dt_s"),
+          "The new time step's factored What: W_eff's held columns are dropped. Collective.")
+      .def(
+          "set_pairs",
+          [](FactorImpact& c, std::vector<ContactPair> pairs, Vector mu, Vector cap)
+          { c.contact->set_pairs(std::move(pairs), std::move(mu), std::move(cap)); },
+          py::arg("pairs"), py::arg("mu"), py::arg("cap") = Vector(),
+          "New pairs on the same contact nodes: B and x0 rebuilt, held columns dropped; "
+          "warm start kept. Collective.")
+      .def(
+          "set_crushing", [](FactorImpact& c, Vector cap) { c.contact->set_crushing(cap); },
+          py::arg("cap"), "As ImpactContact.set_crushing. Collective.")
+      .def_property_readonly("node_crush_depth",
+                             [](const FactorImpact& c) { return c.contact->node_crush_depth(); })
+      .def_property_readonly("B", [](const FactorImpact& c)
+                             { return Eigen::SparseMatrix<double, Eigen::RowMajor>(c.contact->B()); })
+      .def_property_readonly("x0", [](const FactorImpact& c) { return c.contact->x0(); })
+      .def_property_readonly("mu", [](const FactorImpact& c) { return c.contact->mu(); })
+      .def_property_readonly(
+          "frames", [](const FactorImpact& c)
+          { return frames_array(c.contact->contact_pairs(), c.contact->dim()); })
+      .def_property_readonly("cached_pairs",
+                             [](const FactorImpact& c) { return c.contact->cached_pairs(); })
+      .def_property_readonly("block_products",
+                             [](const FactorImpact& c) { return c.contact->block_products(); })
+      .def_property_readonly("block_columns",
+                             [](const FactorImpact& c) { return c.contact->block_columns(); })
+      .def("pairs", [](const FactorImpact& c) { return c.contact->pairs(); })
+      .def("contact_dofs", [](const FactorImpact& c) { return c.contact->contact_dofs(); })
+      .def("dim", [](const FactorImpact& c) { return c.contact->dim(); });
 }

@@ -8,6 +8,7 @@
 #include "constrained.hpp"
 #include "contact_checks.hpp"
 #include "message_numbers.hpp"
+#include "pair_columns.hpp"
 #include "flexcontact/impact.hpp"
 #include "flexcontact/increment.hpp"
 #include "flexcontact/solvers.hpp"
@@ -50,6 +51,16 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
       mu_(std::move(mu)), e_(restitution), dt_(dt_s), theta_(theta),
       constrained_(std::move(constrained)), options_(std::move(options))
 {
+  check_scheme();
+  detail::check_flexibility(F_, contact_dofs(), "Fhat", who);
+  check_mu(mu_, pairs_.size());
+  zero_constrained(F_, constrained_, who);
+  start();
+  W_ = delassus(B_, F_);
+}
+
+void ImpactContact::check_scheme() const
+{
   detail::checked_dim(dim_, who);
   detail::check_coordinates(X_, dim_, who);
   if (!(e_ >= 0.0 && e_ <= 1.0))
@@ -58,16 +69,35 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   check_dt(dt_);
   if (!(theta_ >= 0.5 && theta_ <= 1.0))
     throw std::invalid_argument(who + "theta is " + num(theta_) + "; it must lie in [0.5, 1]");
-  const Eigen::Index n_c = X_.rows() * dim_;
-  detail::check_flexibility(F_, n_c, "Fhat", who);
-  check_mu(mu_, pairs_.size());
-  zero_constrained(F_, constrained_, who);
+}
+
+void ImpactContact::start()
+{
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
   x0_ = initial_gap(pairs_, X_);
-  W_ = delassus(B_, F_);
   last_P_ = Vector::Zero(static_cast<Eigen::Index>(pairs_.size()) * dim_);
   last_states_.assign(pairs_.size(), PairState::open);
   crush_node_ = Vector::Zero(X_.rows());
+}
+
+ImpactContact::ImpactContact(int dim, BlockOperator Fhat, Matrix X,
+                             std::vector<ContactPair> pairs, Vector mu, double restitution,
+                             double dt_s, double theta, std::vector<bool> constrained,
+                             SolverOptions options, double max_bytes)
+    : dim_(dim), X_(std::move(X)), pairs_(std::move(pairs)), mu_(std::move(mu)),
+      e_(restitution), dt_(dt_s), theta_(theta), constrained_(std::move(constrained)),
+      options_(std::move(options)), block_(std::move(Fhat)), max_bytes_(max_bytes)
+{
+  if (!block_)
+    throw std::invalid_argument(who + "the factor path needs a block operator Fhat");
+  check_scheme();
+  if (!(max_bytes_ > 0.0))
+    throw std::invalid_argument(who + "max_bytes is " + num(max_bytes_)
+                                + "; the factor path needs room for W_eff's columns");
+  check_constrained(constrained_, contact_dofs(), who);
+  check_mu(mu_, pairs_.size());
+  start();
+  columns_.slot.assign(pairs_.size(), -1);
 }
 
 void ImpactContact::set_crushing(Vector cap)
@@ -76,8 +106,23 @@ void ImpactContact::set_crushing(Vector cap)
   cap_ = std::move(cap);
 }
 
+void ImpactContact::set_block_flexibility(BlockOperator Fhat, double dt_s)
+{
+  if (!factor_path())
+    throw std::logic_error(who + "set_block_flexibility: this object holds F̂ (dense path)");
+  check_dt(dt_s);
+  if (!Fhat)
+    throw std::invalid_argument(who + "set_block_flexibility: no block operator");
+  block_ = std::move(Fhat);
+  dt_ = dt_s;
+  columns_ = PairColumns{};
+  columns_.slot.assign(pairs_.size(), -1);
+}
+
 void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
 {
+  if (factor_path())
+    throw std::logic_error(who + "set_flexibility: this object applies F̂ through a factor (set_block_flexibility)");
   check_dt(dt_s);
   detail::check_flexibility(Fhat, F_.rows(), "Fhat", who);
   zero_constrained(Fhat, constrained_, who);
@@ -93,7 +138,7 @@ void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector 
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
-  Matrix W = delassus(B, F_);
+  Matrix W = factor_path() ? Matrix() : delassus(B, F_);
   if (pairs.size() != pairs_.size())
   {
     last_P_ = Vector::Zero(static_cast<Eigen::Index>(pairs.size()) * dim_);
@@ -105,15 +150,17 @@ void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector 
   pairs_ = std::move(pairs);
   mu_ = std::move(mu);
   cap_ = std::move(cap);
+  columns_ = PairColumns{}; // they depend on B
+  columns_.slot.assign(pairs_.size(), -1);
 }
 
 ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
                                const Eigen::Ref<const Vector>& v_c,
                                const Eigen::Ref<const Vector>& vfree_c)
 {
-  check_vector("u_c", u_c, F_.rows());
-  check_vector("v_c", v_c, F_.rows());
-  check_vector("vfree_c", vfree_c, F_.rows());
+  check_vector("u_c", u_c, contact_dofs());
+  check_vector("v_c", v_c, contact_dofs());
+  check_vector("vfree_c", vfree_c, contact_dofs());
   const int m = pairs(), d = dim_;
   ImpactStep r;
   r.gap = B_ * u_c + x0_;
@@ -137,7 +184,21 @@ ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
     r.report.converged = true;
     r.report.residual = 0.0;
   }
-  r.velocity = W_ * r.impulse + Ufree;
+  if (factor_path())
+  {
+    // P is zero outside the index set, whose columns the solve fetched.
+    std::vector<int> act;
+    Vector P_act(static_cast<Eigen::Index>(r.active_pairs) * dim_);
+    for (int k = 0; k < m; ++k)
+      if (r.active[k])
+      {
+        P_act.segment(static_cast<Eigen::Index>(act.size()) * d, d) = r.impulse.segment(k * d, d);
+        act.push_back(k);
+      }
+    r.velocity = detail::full_u(columns_, act, P_act, Ufree, d);
+  }
+  else
+    r.velocity = W_ * r.impulse + Ufree;
   finish(r);
   if (cap_.size())
     crush(r);
@@ -150,8 +211,11 @@ ImpactStep ImpactContact::step_condensed(const Eigen::Ref<const Vector>& u_c,
                                          const Eigen::Ref<const Vector>& v_c,
                                          const Eigen::Ref<const Vector>& b_c)
 {
-  check_vector("b_c", b_c, F_.rows());
-  check_vector("v_c", v_c, F_.rows());
+  if (factor_path())
+    throw std::logic_error(who + "step_condensed needs F̂; on the factor path use step() with "
+                                 "the free velocity of a full solve");
+  check_vector("b_c", b_c, contact_dofs());
+  check_vector("v_c", v_c, contact_dofs());
   // F_ has the held rows and columns zeroed; Ŵ's identity rows give them (Ŵ⁻¹)_ii = 1.
   Vector dv_free = F_ * b_c;
   for (std::size_t i = 0; i < constrained_.size(); ++i)
@@ -179,12 +243,19 @@ void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
     }
   const Eigen::Index n = static_cast<Eigen::Index>(idx.size());
   Matrix W(n, n);
+  if (factor_path())
+  {
+    fetch(act);
+    W = detail::restricted_W(columns_, act, d);
+  }
+  else
+    for (Eigen::Index a = 0; a < n; ++a)
+      for (Eigen::Index b = 0; b < n; ++b)
+        W(a, b) = W_(idx[a], idx[b]);
   Vector q(n), mu(act.size()), P0(n);
   std::vector<PairState> s0(act.size());
   for (Eigen::Index a = 0; a < n; ++a)
   {
-    for (Eigen::Index b = 0; b < n; ++b)
-      W(a, b) = W_(idx[a], idx[b]);
     q[a] = Ufree[idx[a]];
     P0[a] = last_P_[idx[a]];
   }
@@ -255,6 +326,23 @@ void ImpactContact::finish(ImpactStep& r) const
   for (std::size_t i = 0; i < constrained_.size(); ++i)
     if (constrained_[i])
       r.reaction[static_cast<Eigen::Index>(i)] = 0.0;
+}
+
+void ImpactContact::fetch(const std::vector<int>& pairs)
+{
+  const bool held = detail::fetch_pair_columns(
+      columns_, pairs, max_bytes_, B_.rows(), dim_, pairs_.size(),
+      [this](const std::vector<int>& p)
+      {
+        ++block_products_;
+        block_columns_ += static_cast<long>(p.size()) * dim_;
+        return detail::delassus_columns(B_, constrained_, block_, p, dim_, who);
+      });
+  if (!held)
+    throw std::runtime_error(
+        who + "the index set's " + std::to_string(pairs.size()) + " pairs need "
+        + num(8.0 * static_cast<double>(B_.rows()) * dim_ * static_cast<double>(pairs.size()) / 1e9)
+        + " GB for W_eff's columns, more than the " + num(max_bytes_ / 1e9) + " GB allowed");
 }
 
 double ImpactContact::crush_of(int k) const

@@ -9,6 +9,7 @@
 #include "constrained.hpp"
 #include "contact_checks.hpp"
 #include "message_numbers.hpp"
+#include "pair_columns.hpp"
 #include "step_summary.hpp"
 
 #include <stdexcept>
@@ -102,73 +103,16 @@ Matrix OperatorContact::W_columns(const std::vector<int>& pairs) const
 {
   if (!block_)
     throw std::logic_error(who + "W_columns needs a block operator (use_working_set)");
-  const int d = dim_;
-  const Eigen::SparseMatrix<double> Bt = B_.transpose();
-  Matrix R = Matrix::Zero(contact_dofs(), static_cast<Eigen::Index>(pairs.size()) * d);
-  for (std::size_t a = 0; a < pairs.size(); ++a)
-  {
-    if (pairs[a] < 0 || pairs[a] >= this->pairs())
-      throw std::invalid_argument(who + "W_columns: pair " + std::to_string(pairs[a])
-                                  + " out of range");
-    for (int i = 0; i < d; ++i)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(Bt, pairs[a] * d + i); it; ++it)
-        R(it.row(), static_cast<Eigen::Index>(a) * d + i) = it.value();
-  }
-  for (std::size_t i = 0; i < constrained_.size(); ++i)
-    if (constrained_[i])
-      R.row(static_cast<Eigen::Index>(i)).setZero();
-  Matrix F = block_(R);
+  Matrix W = detail::delassus_columns(B_, constrained_, block_, pairs, dim_, who);
   ++block_products_;
-  block_columns_ += R.cols();
-  if (F.rows() != R.rows() || F.cols() != R.cols())
-    throw std::runtime_error(who + "the block operator returned " + std::to_string(F.rows())
-                             + "×" + std::to_string(F.cols()) + " for "
-                             + std::to_string(R.rows()) + "×" + std::to_string(R.cols()));
-  for (std::size_t i = 0; i < constrained_.size(); ++i)
-    if (constrained_[i])
-      F.row(static_cast<Eigen::Index>(i)).setZero();
-  return B_ * F;
+  block_columns_ += static_cast<long>(pairs.size()) * dim_;
+  return W;
 }
 
 bool OperatorContact::fetch_columns(const std::vector<int>& pairs)
 {
-  std::vector<int> missing;
-  for (int k : pairs)
-    if (columns_.slot[static_cast<std::size_t>(k)] < 0)
-      missing.push_back(k);
-  if (missing.empty())
-    return true;
-  const int d = dim_;
-  const double per_pair = 8.0 * static_cast<double>(B_.rows()) * d;
-  auto fits = [&](std::size_t count) { return per_pair * static_cast<double>(count) <= max_bytes_; };
-  if (!fits(pairs.size()))
-    return false;
-  if (!fits(columns_.order.size() + missing.size()))
-  {
-    // Keep only the pairs asked for now: earlier increments' columns make room.
-    PairColumns kept;
-    kept.slot.assign(pairs_.size(), -1);
-    kept.columns.resize(B_.rows(), static_cast<Eigen::Index>(pairs.size() - missing.size()) * d);
-    for (int k : pairs)
-      if (const int s = columns_.slot[static_cast<std::size_t>(k)]; s >= 0)
-      {
-        kept.slot[static_cast<std::size_t>(k)] = static_cast<int>(kept.order.size());
-        kept.columns.middleCols(static_cast<Eigen::Index>(kept.order.size()) * d, d)
-            = columns_.columns.middleCols(static_cast<Eigen::Index>(s) * d, d);
-        kept.order.push_back(k);
-      }
-    columns_ = std::move(kept);
-  }
-  const Matrix fresh = W_columns(missing);
-  const Eigen::Index old = columns_.columns.cols();
-  columns_.columns.conservativeResize(B_.rows(), old + fresh.cols());
-  columns_.columns.rightCols(fresh.cols()) = fresh;
-  for (int k : missing)
-  {
-    columns_.slot[static_cast<std::size_t>(k)] = static_cast<int>(columns_.order.size());
-    columns_.order.push_back(k);
-  }
-  return true;
+  return detail::fetch_pair_columns(columns_, pairs, max_bytes_, B_.rows(), dim_, pairs_.size(),
+                                    [this](const std::vector<int>& p) { return W_columns(p); });
 }
 
 SolveReport OperatorContact::solve_local(const Vector& q)

@@ -8,6 +8,7 @@
 #include "flexcontact/residual.hpp"
 #include "flexcontact/solvers.hpp"
 #include "message_numbers.hpp"
+#include "pair_columns.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -67,34 +68,6 @@ std::vector<PairState> states_of(const Vector& lambda, const Vector& u,
   return s;
 }
 
-/// @brief W_AA from the held columns, symmetrised: each column is a separate solve, so W's
-/// symmetry holds only to rounding, and the dense chain expects a symmetric W.
-Matrix restricted_W(const PairColumns& c, const std::vector<int>& A, int d)
-{
-  const Eigen::Index n = static_cast<Eigen::Index>(A.size()) * d;
-  Matrix WA(n, n);
-  for (std::size_t b = 0; b < A.size(); ++b)
-  {
-    const Eigen::Index col = static_cast<Eigen::Index>(c.slot[static_cast<std::size_t>(A[b])]) * d;
-    for (std::size_t a = 0; a < A.size(); ++a)
-      WA.block(static_cast<Eigen::Index>(a) * d, static_cast<Eigen::Index>(b) * d, d, d)
-          = c.columns.block(static_cast<Eigen::Index>(A[a]) * d, col, d, d);
-  }
-  return 0.5 * (WA + WA.transpose());
-}
-
-/// @brief u = W λ + q on every pair, λ nonzero only on the set A (its columns are held).
-Vector full_u(const PairColumns& c, const std::vector<int>& A, const Vector& lamA,
-              const Eigen::Ref<const Vector>& q, int d)
-{
-  Vector u = q;
-  for (std::size_t b = 0; b < A.size(); ++b)
-    u.noalias() += c.columns.middleCols(
-                       static_cast<Eigen::Index>(c.slot[static_cast<std::size_t>(A[b])]) * d, d)
-                   * lamA.segment(static_cast<Eigen::Index>(b) * d, d);
-  return u;
-}
-
 /// @brief The pairs that start the working set: those penetrating under q alone, and those
 /// that carried a force in λ0 (their columns give u at the warm start).
 std::vector<int> initial_set(const Eigen::Ref<const Vector>& q, const Vector& lam, int d)
@@ -126,7 +99,7 @@ Restricted restrict_to(const PairColumns& c, const std::vector<int>& A, int d,
     for (std::size_t a = 0; a < A.size(); ++a)
       r.cap[static_cast<Eigen::Index>(a)] = cap[A[a]];
   }
-  r.W = restricted_W(c, A, d);
+  r.W = detail::restricted_W(c, A, d);
   const Eigen::Index n = static_cast<Eigen::Index>(A.size()) * d;
   r.q.resize(n);
   r.lambda.resize(n);
@@ -320,7 +293,7 @@ SolveReport solve_working_set(int dim, const PairColumns& columns, const FetchCo
                              + (rep.attempts.empty() ? rep.solver : rep.attempts.back()) + ")");
       return out;
     }
-    Vector u = full_u(columns, A, rep.lambda, q, dim);
+    Vector u = detail::full_u(columns, A, rep.lambda, q, dim);
     for (std::size_t a = 0; a < A.size(); ++a) // the restricted solve's own u: its residual
       u.segment(A[a] * dim, dim) = rep.u.segment(static_cast<Eigen::Index>(a) * dim, dim);
     const std::size_t before = A.size();

@@ -154,6 +154,9 @@ class Condensation:
                 error = f"{where}: {e}"
         raise_on_every_rank(self.comm, error)
         self.factor, self.flex_info = factor, dict(info)
+        # The two-solve step's reaction vectors take A's layout: the caller destroys the
+        # old matrix.
+        self._template = A
         self.factorizations += 1
         self._cached = None
 

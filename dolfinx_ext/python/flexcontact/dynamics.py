@@ -40,7 +40,9 @@ from . import _cpp, impact_setup as setup
 from ._cpp import SolverOptions
 from .condensation import Condensation
 from .energy import EnergyAccount
-from .names import check_chain, check_flexibility_method, check_ordering
+from .factor_path import FactorImpactCondensation
+from .names import (CONTACT_OPERATORS, ContactOperator, check_chain, check_flexibility_method,
+                    check_option, check_ordering)
 from .pairing import pair_interfaces
 from .postprocess import ContactFields
 from .states import CRUSH, OPEN, SLIP, STICK
@@ -112,6 +114,11 @@ class ImpactProblem(StepperViews):
     initial_displacement : a Function on V (m) to start from, e.g. a static state under
         ``loads`` (zeroed at held DOFs); None: zero. Its strain energy is the initial one.
     solver, flexibility, ordering : as for ContactProblem.
+    contact_operator : "dense" (default): F̂ = (Ŵ⁻¹)_cc and W_eff formed once, a step about
+        one back-substitution; "factor": one plain factorization of Ŵ, W_eff's columns of
+        the pairs that come into contact fetched through it and held (docs/impact.md,
+        "The factor path"), two solves per step while an impulse acts. For contact zones
+        too large for the dense path's 8·n_c² bytes.
 
     Node–surface pairs are re-made before every step but the first (``repair``: B, x0 and
     W_eff from the stored F̂, no factorization; ``pairings`` counts them), unless
@@ -133,10 +140,13 @@ class ImpactProblem(StepperViews):
                  ordering: str = "auto", expected_contact_s: Optional[float] = None,
                  initial_displacement: Optional[dolfinx.fem.Function] = None,
                  repair_pairs: bool = True,
-                 added_mass: Optional[Callable[[ufl.Argument, ufl.Argument], ufl.Form]] = None):
+                 added_mass: Optional[Callable[[ufl.Argument, ufl.Argument], ufl.Form]] = None,
+                 contact_operator: ContactOperator = "dense"):
         from . import forms
         setup.check_scheme(dt_s, restitution, theta, mass, rayleigh)
         check_flexibility_method(flexibility)
+        check_option(contact_operator, CONTACT_OPERATORS, "contact_operator")
+        self.contact_operator = contact_operator
         check_ordering(ordering)
         self.ordering = ordering
         if solver is not None:
@@ -211,9 +221,15 @@ class ImpactProblem(StepperViews):
         def kernel(dim, F, X, kpairs, mu, constrained, options):
             return _cpp.ImpactContact(dim, F, X, kpairs, mu, e, dt, th, constrained, options)
 
-        condensation = Condensation(self.W_hat, self.bcs, self.pairs, self.mu, self.dim,
-                                    self.comm, self.options, flexibility, kernel=kernel,
-                                    ordering=self.ordering)
+        if self.contact_operator == "factor":
+            condensation = FactorImpactCondensation(
+                self.W_hat, self.bcs, self.pairs, self.mu, self.dim, self.comm, self.options,
+                restitution=e, dt_s=dt, theta=th, ordering=self.ordering)
+            flexibility = "factor"
+        else:
+            condensation = Condensation(self.W_hat, self.bcs, self.pairs, self.mu, self.dim,
+                                        self.comm, self.options, flexibility, kernel=kernel,
+                                        ordering=self.ordering)
         self.stepper = Stepper(condensation, self.comm, expand_key="velocity_change_c",
                                timings=self.timings)
         self.flexibility_method = flexibility

@@ -82,10 +82,9 @@ class FactorCondensation(Condensation):
             (self.dofs, np.asarray(pairs.x), _pair_arrays(pairs), np.asarray(mu), constrained,
              working_set_bytes(), pair_caps(pairs)) if root else None, root=0)
         t0 = time.perf_counter()
-        self.contact = _cpp.FactorContact(dim, self.factor.handle, K.handle, dofs,
-                                          self.n_virtual_dofs, x,
-                                          _kernel_pairs(arrays), mu, constrained, options,
-                                          self.working_set_bytes)
+        self._kernel_dofs = dofs
+        self.contact = self._make_contact(dim, K, dofs, x, _kernel_pairs(arrays), mu,
+                                          constrained, options)
         if caps is not None:
             self.contact.set_crushing(caps)
         self.timings["delassus_s"] = time.perf_counter() - t0
@@ -93,6 +92,10 @@ class FactorCondensation(Condensation):
 
     collective = True
     """Every rank holds the kernel object and runs the same step."""
+
+    def _make_contact(self, dim, K, dofs, x, kpairs, mu, constrained, options):
+        return _cpp.FactorContact(dim, self.factor.handle, K.handle, dofs, self.n_virtual_dofs,
+                                  x, kpairs, mu, constrained, options, self.working_set_bytes)
 
     def _operator(self, name: str):
         # W is never formed; B, x0 and the frames are read on rank 0, as on the dense path.
@@ -107,4 +110,44 @@ class FactorCondensation(Condensation):
         arrays, mu, caps = self.comm.bcast(
             (_pair_arrays(pairs), np.asarray(mu), pair_caps(pairs)) if root else None, root=0)
         self.contact.set_pairs(_kernel_pairs(arrays), mu, np.zeros(0) if caps is None else caps)
+        self._cached = None
+
+
+class FactorImpactCondensation(FactorCondensation):
+    """The factor path of ImpactProblem (``contact_operator="factor"``): one plain
+    factorization of Ŵ = M + hθC + h²θ²K and the kernel's ``FactorImpact`` on every rank.
+
+    Each time step's index set fetches W_eff's columns of its pairs not held yet (one block
+    of back-substitutions) and keeps them; its local problem is the dense path's (the same
+    chain on W_eff restricted to the index set), so the answers agree to rounding. A step
+    costs two solves while an impulse acts (v_free, then v⁺), one otherwise."""
+
+    def __init__(self, W_hat: PETSc.Mat, bcs: Sequence, pairs, mu: Optional[np.ndarray],
+                 dim: int, comm, options, *, restitution: float, dt_s: float, theta: float,
+                 ordering: str = "auto"):
+        self._scheme = (float(restitution), float(dt_s), float(theta))
+        super().__init__(W_hat, bcs, pairs, mu, dim, comm, options, ordering=ordering)
+
+    def _make_contact(self, dim, K, dofs, x, kpairs, mu, constrained, options):
+        if not self.working_set_bytes > 0:
+            raise InputError("contact_operator='factor': no memory allowed for W_eff's "
+                             "columns (FLEXCONTACT_WORKING_SET_GB = 0); the impact factor "
+                             "path needs the index set's columns")
+        e, dt, theta = self._scheme
+        return _cpp.FactorImpact(dim, self.factor.handle, K.handle, dofs, self.n_virtual_dofs,
+                                 x, kpairs, mu, e, dt, theta, constrained, options,
+                                 self.working_set_bytes)
+
+    def refactor(self, A: PETSc.Mat, method: str, ordering: str, dt_s: float,
+                 where: str) -> None:
+        """The new time step's Ŵ factored (one plain factorization) and handed to every
+        rank's kernel object, whose held columns are dropped. Collective."""
+        _, factor, info = _cpp.flexibility(A, np.zeros(0, np.int64), "inverse_entries",
+                                           ordering)
+        self.contact.set_flexibility(factor.handle, A.handle, self._kernel_dofs,
+                                     self.n_virtual_dofs, float(dt_s))
+        self.factor, self.flex_info = factor, dict(info, method="factor")
+        # The reaction's vectors take A's layout: the old Ŵ is destroyed by the caller.
+        self._template = A
+        self.factorizations += 1
         self._cached = None

@@ -91,9 +91,9 @@ def check_dense_memory(n_contact_dofs: int, pairs: int, dim: int,
             f"(F* and the Schur complement on n_c = {n_contact_dofs} contact DOFs: "
             f"{FSTAR_COPIES} x 8·n_c² bytes; W of m = {pairs} pairs: {W_COPIES} x 8·(m·d)² "
             f"bytes, d = {dim}) but only {avail / 1e9:.2f} GB are available; use "
-            "ContactProblem(..., contact_operator=\"factor\"), which works through the "
-            "factor of K without forming F* or the whole W, or tag a smaller candidate contact "
-            "zone")
+            "contact_operator=\"factor\" (ContactProblem or ImpactProblem), which works "
+            "through the factor of K (or Ŵ) without forming F* or the whole W, or tag a "
+            "smaller candidate contact zone")
     raise ContactMemoryError(text, needed, avail, n_contact_dofs, pairs)
 
 

@@ -149,7 +149,9 @@ class Stepper:
         if root:
             values = c.contact_values(values)
         if self.collective:
-            values = self.comm.bcast(values, root=0)
+            # Every rank steps its own kernel object: each needs rank 0's arguments.
+            values, before, after = self.comm.bcast(
+                (values, tuple(before), tuple(after)) if root else None, root=0)
         out, failure = None, None
         if runs_kernel:
             out, failure = self._kernel_step(values, before, after, where, on_failure, root)

@@ -20,6 +20,7 @@
 /// the same local solvers serve. I holds the pairs whose predicted gap g⁻ + hθ U_n⁻ is ≤ 0.
 /// Contact DOFs are node-major as in pairs.hpp.
 
+#include "flexcontact/operator_contact.hpp"
 #include "flexcontact/pairs.hpp"
 #include "flexcontact/problem.hpp"
 
@@ -87,6 +88,17 @@ public:
                 double restitution, double dt_s, double theta,
                 std::vector<bool> constrained = {}, SolverOptions options = {});
 
+  /// @brief The factor path: F̂ is not formed but applied to blocks of columns through the
+  /// caller's factor of Ŵ (`Fhat`: Y = F̂ R, one multi-right-hand-side back-substitution).
+  /// A step fetches W_eff's columns of the pairs of its index set that it does not hold yet
+  /// (W[:, k] = B F̂ Bᵀ e_k, one block for all of them) and keeps them for the next steps,
+  /// within `max_bytes` (8 bytes per entry of the m·d × d·pairs columns); the local problem
+  /// is then the dense one's, restricted to the index set as on the dense path, so the
+  /// answers agree to rounding. step_condensed is not available (it needs F̂ itself).
+  ImpactContact(int dim, BlockOperator Fhat, Matrix X, std::vector<ContactPair> pairs, Vector mu,
+                double restitution, double dt_s, double theta, std::vector<bool> constrained,
+                SolverOptions options, double max_bytes);
+
   /// @brief Contact impulses of one step from the contact-DOF values of u⁻, v⁻ and v_free.
   /// @throws std::invalid_argument on wrong sizes or non-finite values
   /// @throws ConvergenceError if no local solver converges (the warm start is kept)
@@ -136,10 +148,23 @@ public:
   /// @throws std::invalid_argument on a wrong size, non-finite entries or dt_s ≤ 0
   void set_flexibility(Matrix Fhat, double dt_s);
 
+  /// @brief The factor path's new time-step size: the new Ŵ's block flexibility; the held
+  /// columns are dropped.
+  /// @throws std::invalid_argument on dt_s ≤ 0, std::logic_error on the dense path
+  void set_block_flexibility(BlockOperator Fhat, double dt_s);
+
+  /// @brief True when F̂ is applied through a factor rather than held (the factor path).
+  bool factor_path() const { return static_cast<bool>(block_); }
+  /// @brief Pairs whose columns of W_eff are held (factor path).
+  int cached_pairs() const { return static_cast<int>(columns_.order.size()); }
+  /// @brief Block products and the columns they solved for, since construction (factor path).
+  long block_products() const { return block_products_; }
+  long block_columns() const { return block_columns_; }
+
   const Eigen::SparseMatrix<double>& B() const { return B_; } ///< m·d × n_c
   const Vector& x0() const { return x0_; }                   ///< initial gap, m·d
-  const Matrix& W() const { return W_; }                     ///< W_eff, m·d × m·d
-  const Matrix& flexibility() const { return F_; }           ///< F̂, constrained zeroed
+  const Matrix& W() const { return W_; }          ///< W_eff, m·d × m·d (dense path only)
+  const Matrix& flexibility() const { return F_; } ///< F̂, constrained zeroed (dense path only)
   const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
   const Vector& mu() const { return mu_; }
   double restitution() const { return e_; }
@@ -147,9 +172,13 @@ public:
   double theta() const { return theta_; }
   int dim() const { return dim_; }
   int pairs() const { return static_cast<int>(pairs_.size()); }
-  int contact_dofs() const { return static_cast<int>(F_.rows()); }
+  int contact_dofs() const { return static_cast<int>(X_.rows()) * dim_; }
 
 private:
+  /// @brief Throws std::invalid_argument naming a bad dim, coordinates, e, dt or θ.
+  void check_scheme() const;
+  /// @brief B, x0 and a state at rest (no impulse, all pairs open, nothing crushed).
+  void start();
   /// @brief Impulses of the pairs in I from the local problem x = W_II P + q_I.
   void solve_active(ImpactStep& r, const Vector& Ufree);
   /// @brief Reaction, totals and the energy terms of a solved step.
@@ -158,6 +187,8 @@ private:
   void crush(ImpactStep& r);
   /// @brief δ of pair k's slave node (0 without crushing).
   double crush_of(int k) const;
+  /// @brief Factor path: W_eff's columns of `pairs` held (fetched if missing).
+  void fetch(const std::vector<int>& pairs);
 
   int dim_;
   Matrix F_;
@@ -173,6 +204,10 @@ private:
   Vector cap_;                     ///< force caps per pair, empty: no crushing
   Vector crush_node_;              ///< crush depth δ per contact node [m]
   Vector last_P_;                  ///< warm start
+  BlockOperator block_;            ///< factor path: Y = F̂ R (empty: the dense path)
+  double max_bytes_ = 0.0;
+  PairColumns columns_;            ///< factor path: W_eff's held columns
+  long block_products_ = 0, block_columns_ = 0;
   std::vector<PairState> last_states_;
 };
 } // namespace flexcontact
