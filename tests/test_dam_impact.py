@@ -145,3 +145,15 @@ def test_westergaard_adds_seven_twelfths_rho_h_squared_and_keeps_momentum(impact
     dp = rw.log_momentum_change
     assert abs(rw.metrics["impulse"] - abs(dp)) <= 0.01 * abs(dp)
     assert abs(rw.metrics["peak_force"] / r.metrics["peak_force"] - 1.0) <= 0.01
+
+
+def test_factor_path_gives_the_dense_answer(impact):
+    """The log/dam impact through the factor of Ŵ (no dense F̂, docs/impact.md): the same
+    force history as the dense path, step by step, to 1e-9 of the peak."""
+    s, r, stage1 = impact
+    f = solve_stage2(s, stage1, comm=COMM, contact_operator="factor")
+    force_d = np.array([x.normal_force for x in r.problem.records])
+    force_f = np.array([x.normal_force for x in f.problem.records])
+    assert force_d.shape == force_f.shape and force_d.max() > 0
+    assert np.abs(force_f - force_d).max() <= 1e-9 * force_d.max()
+    assert f.problem.W_eff is None and f.problem.factorizations == 1

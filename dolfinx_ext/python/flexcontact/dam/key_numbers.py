@@ -94,7 +94,8 @@ def study_scenarios(s, ratio: float) -> list:
                   for k in (1, 2)]
 
 
-def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None) -> dict:
+def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None,
+                   contact_operator: str = "dense") -> dict:
     """Stage 1 and stage 2 of ``s`` without output files; the engineer's numbers with the
     mesh's size. Collective."""
     from mpi4py import MPI
@@ -104,7 +105,7 @@ def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None) -> dic
     comm = comm or MPI.COMM_WORLD
     stage1 = solve_stage1(s, comm=comm)
     stage2 = solve_stage2(s, stage1, offset_m=impact_offset_m, duration_s=duration_s,
-                          comm=comm)
+                          comm=comm, contact_operator=contact_operator)
     cells = stage1.mesh.msh.topology.index_map(stage1.mesh.msh.topology.dim)
     row = engineer_numbers(s, stage1, stage2)
     row.update(refine=s.refine, h_impact_m=s.h_impact_m, h_far_m=s.h_far_m,

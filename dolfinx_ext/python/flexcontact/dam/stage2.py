@@ -155,8 +155,10 @@ def log_crushing_strength_Pa(s) -> Optional[float]:
     return s.wood_crushing_strength_Pa if s.log_end_crushes else None
 
 
-def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
-    """The ImpactProblem of stage 2 (collective)."""
+def make_problem(s, stage1, dt_s: float, contact_operator: str = "dense") -> ImpactProblem:
+    """The ImpactProblem of stage 2 (collective). ``contact_operator``: "dense", or "factor"
+    for contact zones whose dense F̂ would not fit (docs/impact.md, "The factor path"; the
+    same answer to rounding)."""
     mesh, V = stage1.mesh, stage1.V
     dx, ds = _measures(mesh)
     v = ufl.TestFunction(V)
@@ -171,7 +173,8 @@ def make_problem(s, stage1, dt_s: float) -> ImpactProblem:
         materials, stage2_supports(s, V, mesh), contact, dt_s=dt_s, kind=stage1.kind,
         initial_velocity={"log": tuple(speed)}, loads=loads["dam"] + loads["foundation"],
         initial_displacement=stage1.u, repair_pairs=False,
-        added_mass=westergaard_form(s, mesh) if s.westergaard else None)
+        added_mass=westergaard_form(s, mesh) if s.westergaard else None,
+        contact_operator=contact_operator)
 
 
 WESTERGAARD_QUADRATURE_DEGREE = 12
@@ -197,14 +200,15 @@ def westergaard_form(s, mesh):
 def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
                  duration_s: Optional[float] = None, offset_m: float = 1.0,
                  writer=None, write_every: int = 5, stress_every: int = 1,
-                 comm=MPI.COMM_WORLD) -> Stage2Result:
+                 comm=MPI.COMM_WORLD, contact_operator: str = "dense") -> Stage2Result:
     """Run the impact from ``stage1`` (a Stage1Result of the same scenario). Collective.
 
     ``dt_s``: time step (default :func:`default_time_step_s`); ``duration_s``: simulated
     time (default: the approach gap / (speed · x) plus MARGIN × 2L/c of the log); ``offset_m``: the
     distance from the first-contact point on the face at which the largest principal
     stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
-    ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps.
+    ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps;
+    ``contact_operator``: as for :func:`make_problem`.
 
     Besides the contact metrics the result holds, for every step, the base section from
     the dam's displacement (``section_history``), the log's largest rigid rotation and
@@ -217,7 +221,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
         raise InputError(f"duration_s={duration_s!r}: must be a finite number > 0 s")
     t0 = time.perf_counter()
     dt = dt_s if dt_s is not None else default_time_step_s(s)
-    problem = make_problem(s, stage1, dt)
+    problem = make_problem(s, stage1, dt, contact_operator)
     t_setup = time.perf_counter() - t0
     if duration_s is None:
         duration_s = approach_time_s(s) + MARGIN * problem.expected_contact_s
