@@ -470,7 +470,7 @@ def test_end_shape_is_sampled_uniformly_and_reported_per_name(tmp_path):
     w = summary["worst"]["peak_force_N_per_m"]
     assert w["value"] == force.max() and w["inputs"] == points[int(np.argmax(force))]
     report = (tmp_path / "out" / "report.md").read_text()
-    assert "## By `log_end_shape`" in report
+    assert "## By log end shape (`log_end_shape`)" in report
     assert (tmp_path / "out" / "envelope_peak_force_N_per_m.png").exists()
     rows = (tmp_path / "out" / "results.csv").read_text()
     assert "'rounded'" in rows

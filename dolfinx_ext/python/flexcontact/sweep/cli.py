@@ -52,9 +52,12 @@ def main(args) -> int:
     print(f"{summary['scenarios']} scenarios, {summary['computed_this_run']} computed in "
           f"{summary['wall_s']:.1f} s; results in {folder}/ (results.csv, summary.json, "
           f"report.md)")
+    from .quantities import quantity
+    dim = summary.get("dim", 2)
     for o, w in summary["worst"].items():
         if w is not None:
-            print(f"  worst {o}: {w['value']:.6g} (scenario {w['id']}: "
-                  + ", ".join(f"{k}={v}" if isinstance(v, str) else f"{k}={v:.4g}"
-                              for k, v in w["inputs"].items()) + ")")
+            q = quantity(o, dim)
+            print(f"  worst {q.words.lower()}: {q.show(w['value'])} {q.unit} (scenario "
+                  f"{w['id']}: " + ", ".join(f"{k}={quantity(k, dim).show(v)}"
+                                            for k, v in w["inputs"].items()) + ")")
     return 0

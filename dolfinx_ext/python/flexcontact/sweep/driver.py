@@ -12,7 +12,6 @@ from .errors import ConfigError
 from .evaluators import EvaluatorSpec
 from .progress import Progress
 from .scenarios import build_scenarios, point_hash
-from .stats import KEY_OUTPUTS
 from .table import ResultTable
 
 
@@ -142,8 +141,7 @@ def convergence(prep: dict, worst: dict) -> dict:
     fine = EvaluatorSpec(spec.name, spec.base.replace(refine=spec.base.refine + 1),
                          spec.dt_s, spec.water_levels_m)
     ev, cache, out = fine.build(), {}, {}
-    for o in KEY_OUTPUTS:
-        w = worst.get(o)
+    for o, w in worst.items():
         if w is None:
             continue
         s = prep["scenarios"][w["id"]]

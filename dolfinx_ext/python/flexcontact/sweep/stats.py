@@ -11,11 +11,25 @@ from __future__ import annotations
 import numpy as np
 
 KEY_OUTPUTS = ("peak_force_N_per_m", "heel_stress_impact_Pa", "peak_tensile_stress_Pa")
-ENVELOPE_OUTPUTS = KEY_OUTPUTS + ("impulse_N_s_per_m", "contact_duration_s",
-                                  "peak_contact_pressure_Pa")
-"""The outputs an engineer reads off envelope plots (the others — counts, steps, the time
-step — stay in the table)."""
-"""The outputs whose most unfavourable case is reported (largest is worst)."""
+"""The outputs whose most unfavourable case is reported (largest is worst), with the
+filtered peak force where the evaluator gives it (:func:`key_outputs`)."""
+DESIGN_OUTPUTS = ("peak_force_filtered_N_per_m", "peak_force_N_per_m", "impulse_N_s_per_m",
+                  "heel_stress_impact_Pa", "peak_tensile_stress_Pa")
+"""The outputs a design reads: their rank correlations with the inputs are reported (the
+others — counts, steps, the time step, the log's own kinematics — stay in the table)."""
+ENVELOPE_OUTPUTS = DESIGN_OUTPUTS + ("contact_duration_s", "peak_contact_pressure_Pa")
+"""The outputs an engineer reads off envelope plots."""
+
+
+def key_outputs(outputs) -> list:
+    """The outputs whose worst case and exceedance are reported, among ``outputs``: the
+    filtered peak force first where there is one."""
+    return [o for o in ("peak_force_filtered_N_per_m",) + KEY_OUTPUTS if o in outputs]
+
+
+def design_outputs(outputs) -> list:
+    """:data:`DESIGN_OUTPUTS` among ``outputs``, in that order."""
+    return [o for o in DESIGN_OUTPUTS if o in outputs]
 
 
 def column(rows: list, output: str) -> np.ndarray:
@@ -48,6 +62,25 @@ def exceedance(values, bootstrap: int, band: float, seed: int) -> dict:
     lower, upper = np.percentile(curves, [q, 100.0 - q], axis=0)
     return {"x": x.tolist(), "p": p.tolist(), "lower": lower.tolist(),
             "upper": upper.tolist(), "n": int(n), "band": band, "bootstrap": bootstrap}
+
+
+def probability_above(values, limits, bootstrap: int, band: float, seed: int) -> dict:
+    """P[X > limit] as the fraction of finite ``values`` above their ``limits`` (one per
+    value, or one for all), and its two-sided ``band`` from ``bootstrap`` resamples of the
+    (value, limit) pairs (numpy Generator of ``seed``)."""
+    x = np.asarray(values, float)
+    f = np.broadcast_to(np.asarray(limits, float), x.shape)
+    ok = np.isfinite(x)
+    above = (x[ok] > f[ok]).astype(float)
+    n = above.size
+    if n == 0:
+        return {"p": float("nan"), "lower": float("nan"), "upper": float("nan"), "n": 0}
+    rng = np.random.default_rng(seed)
+    resampled = np.array([above[rng.integers(0, n, n)].mean() for _ in range(bootstrap)])
+    q = 100.0 * (1.0 - band) / 2.0
+    lower, upper = np.percentile(resampled, [q, 100.0 - q])
+    return {"p": float(above.mean()), "lower": float(lower), "upper": float(upper),
+            "n": int(n), "above": int(above.sum()), "band": band, "bootstrap": bootstrap}
 
 
 def _survival(sample_sorted: np.ndarray, at: np.ndarray) -> np.ndarray:

@@ -1,4 +1,10 @@
-"""``summary.json`` and ``report.md`` of a finished sweep (and its figures)."""
+"""``summary.json`` and ``report.md`` of a finished sweep (and its figures).
+
+The report reads as a design note: outputs named in words with their definition, forces in
+MN and stresses in MPa to three significant figures, each stress against the concrete's
+tensile strength, correlations of the design outputs with the inputs. summary.json and
+results.csv keep SI values at full precision.
+"""
 from __future__ import annotations
 
 import math
@@ -8,6 +14,7 @@ import numpy as np
 
 from . import plots, stats
 from .plots import CONDITIONAL
+from .quantities import quantity, three_figures
 
 PROBABILITIES = (0.5, 0.1, 0.01)
 """Exceedance probabilities at which the report quotes the value exceeded."""
@@ -23,94 +30,214 @@ def exceeded_at(curve: dict) -> dict:
     return out
 
 
+def tensile_strengths(rows: list, base: dict) -> np.ndarray:
+    """f_t of each row (Pa): its swept value, or the base scenario's."""
+    ft = float(base.get("concrete_tensile_strength_Pa", math.nan))
+    return np.array([float(r["inputs"].get("concrete_tensile_strength_Pa", ft)) for r in rows])
+
+
 def summarize(run: dict, rows: list, inputs: list, outputs: list, cfg) -> dict:
     """The summary of the sorted ``rows`` of a run (see :func:`flexcontact.sweep.run`)."""
     s = dict(run)
+    s["dim"] = int(run.get("base", {}).get("dim", 2))
     s["counts"] = stats.total_counts(rows)
+    s["input_ranges"] = input_ranges(rows, inputs)
+    key = stats.key_outputs(outputs) or list(stats.KEY_OUTPUTS)
     s["worst"] = {}
-    for o in stats.KEY_OUTPUTS:
+    for o in key:
         r = stats.worst(rows, o)
         s["worst"][o] = None if r is None else {"id": r["id"], "value": r["outputs"][o],
                                                 "inputs": r["inputs"], "outputs": r["outputs"]}
-    s["spearman"] = stats.spearman(rows, inputs, outputs)
-    s["by_category"] = {n: stats.by_category(rows, n, list(stats.KEY_OUTPUTS))
+    s["spearman"] = stats.spearman(rows, inputs, stats.design_outputs(outputs))
+    s["by_category"] = {n: stats.by_category(rows, n, key)
                         for n in inputs if stats.categorical(rows, n)}
     if cfg.method != "grid":
         s["exceedance"] = {"note": CONDITIONAL}
-        for o in stats.KEY_OUTPUTS:
-            curve = stats.exceedance(stats.column(rows, o), cfg.output["bootstrap"],
-                                     cfg.output["band"], cfg.seed)
+        ft = tensile_strengths(rows, run.get("base", {}))
+        for o in key:
+            values = stats.column(rows, o)
+            curve = stats.exceedance(values, cfg.output["bootstrap"], cfg.output["band"],
+                                     cfg.seed)
             curve["exceeded_at"] = exceeded_at(curve)
+            if quantity(o, s["dim"]).stress and np.isfinite(ft).all():
+                curve["above_tensile_strength"] = stats.probability_above(
+                    values, ft, cfg.output["bootstrap"], cfg.output["band"], cfg.seed)
+                curve["tensile_strength_Pa"] = (float(ft[0]) if np.ptp(ft) == 0 else None)
             s["exceedance"][o] = curve
     return s
 
 
 def figures(folder: Path, summary: dict, rows: list, inputs: list, outputs: list) -> list:
-    plotted = [o for o in outputs if o in stats.ENVELOPE_OUTPUTS] or list(outputs)
-    paths = plots.envelope_plots(folder, rows, inputs, plotted)
+    dim = summary.get("dim", 2)
+    plotted = [o for o in stats.ENVELOPE_OUTPUTS if o in outputs] or list(outputs)
+    paths = plots.envelope_plots(folder, rows, inputs, plotted, dim)
     for o, curve in summary.get("exceedance", {}).items():
         if o != "note" and curve["n"]:
-            paths.append(plots.exceedance_plot(folder, o, curve))
+            paths.append(plots.exceedance_plot(folder, o, curve, dim))
     return [p.name for p in paths]
 
 
-def _fmt(v) -> str:
-    if isinstance(v, str):
-        return v
-    if isinstance(v, int):
-        return str(v)
-    return "nan" if v is None or not math.isfinite(v) else f"{v:.6g}"
+def _band(a: dict) -> str:
+    """P[X > f_t] and its band, as the report and the figures write it."""
+    return (f"{three_figures(a['p'])} ({100 * a['band']:.0f} % bootstrap band "
+            f"{three_figures(a['lower'])}–{three_figures(a['upper'])}; {a['above']} of "
+            f"{a['n']} scenarios)")
+
+
+def input_ranges(rows: list, inputs: list) -> dict:
+    """{input: {"min", "median", "max"}} over the rows, or {"values": [...]} for a
+    categorical one."""
+    out = {}
+    for n in inputs:
+        values = [r["inputs"][n] for r in rows]
+        if any(isinstance(v, str) for v in values):
+            out[n] = {"values": sorted(set(map(str, values)))}
+        elif values:
+            v = np.array(values, float)
+            out[n] = {"min": float(v.min()), "median": float(np.median(v)),
+                      "max": float(v.max())}
+    return out
+
+
+def _inputs_table(dim: int, ranges: dict) -> list:
+    L = ["| input | smallest | median | largest |", "|---|---|---|---|"]
+    for n, r in ranges.items():
+        q = quantity(n, dim)
+        if "values" in r:
+            L.append(f"| {q.words} | " + ", ".join(r["values"]) + " | | |")
+        else:
+            L.append(f"| {q.label()} | {q.show(r['min'])} | {q.show(r['median'])} | "
+                     f"{q.show(r['max'])} |")
+    return L
 
 
 def markdown(summary: dict, inputs: list) -> str:
-    """The engineer's report: worst cases, exceedance, rank correlations, counts."""
+    """The engineer's report: what was swept, the design outputs in words, the most
+    unfavourable scenarios, exceedance and the tensile strength, what drives the outputs,
+    and (last) what the computation cost."""
     s = summary
-    L = [f"# Sweep `{s['config']}`", "",
-         f"{s['scenarios']} scenarios ({s['method']}), evaluator `{s['evaluator']}`, engine "
-         f"`{s['engine']}`, time step {s['dt_s']:.6g} s, wall time {s['wall_s']:.1f} s "
-         f"this run ({s['computed_this_run']} scenarios computed, "
-         f"{s['scenarios'] - s['computed_this_run']} from an earlier run).", "",
-         "## Most unfavourable scenarios", "",
-         "| output | value | id | " + " | ".join(inputs) + " |",
-         "|---|---|---|" + "---|" * len(inputs)]
+    dim = s.get("dim", 2)
+    base = s.get("base", {})
+    q = {o: quantity(o, dim) for o in set(s["worst"]) | set(s["spearman"])}
+    where = ("the 2D plane-strain section of the dam: forces and impulses are per metre of "
+             "dam, as if a raft of logs abreast struck the whole crest — not one log"
+             if dim == 2 else "the 3D dam block, one log: forces and impulses are totals")
+    L = [f"# Debris impact on the dam: sweep `{s['config']}`", "",
+         f"{s['scenarios']} impacts of a floating log on {where}. Scenarios drawn by "
+         f"{'a grid' if s['method'] == 'grid' else s['method'].upper()} over "
+         f"{len(inputs)} inputs; every other parameter is the base scenario's"
+         + (f" (dam {three_figures(base['dam_height_m'])} m high"
+            f", concrete tensile strength "
+            f"{three_figures(base['concrete_tensile_strength_Pa'], 1e-6)} MPa)"
+            if "dam_height_m" in base else "") + ". " + _end(base), ""]
+    if s.get("input_ranges"):
+        L += ["## Inputs", "", "The range each input took over the sweep.", "",
+              *_inputs_table(dim, s["input_ranges"]), ""]
+    L += ["## Design outputs", "", "| output | unit | definition |", "|---|---|---|"]
+    offset = next((w["outputs"].get("stress_offset_m") for w in s["worst"].values() if w),
+                  None)
+    for o in s["spearman"] or s["worst"]:
+        d = q[o].definition
+        if o == "peak_tensile_stress_Pa" and offset is not None:
+            d += f" Read at {three_figures(offset)} m from it."
+        L.append(f"| {q[o].words} | {q[o].unit} | {d} |")
+    L += ["", "## Most unfavourable scenarios", "",
+          "| output | value | scenario | " + " | ".join(quantity(n, dim).label()
+                                                         for n in inputs) + " |",
+          "|---|---|---|" + "---|" * len(inputs)]
     for o, w in s["worst"].items():
         if w is None:
-            L.append(f"| {o} | (no finite value) | | " + " | " * len(inputs))
+            L.append(f"| {q[o].words} | (no finite value) | | " + " | " * len(inputs))
             continue
-        L.append(f"| {o} | {_fmt(w['value'])} | {w['id']} | "
-                 + " | ".join(_fmt(w["inputs"][n]) for n in inputs) + " |")
+        L.append(f"| {q[o].words} | {q[o].show(w['value'])} {q[o].unit} | {w['id']} | "
+                 + " | ".join(quantity(n, dim).show(w["inputs"][n]) for n in inputs) + " |")
     if "exceedance" in s:
-        L += ["", "## Exceedance", "", f"P[X > x] among the sampled impacts: {CONDITIONAL}. "
-              "The value x exceeded with probability p (empirical), figures "
-              "`exceedance_<output>.png` with the bootstrap band.", "",
+        L += ["", "## Exceedance", "",
+              f"P[X > x | impact]: the share of the sampled impacts above x, {CONDITIONAL}. "
+              "The table gives the value exceeded with each probability (empirical; "
+              "— where the sample is too small to resolve it). The figures "
+              "`exceedance_<output>.png` show the whole curve with its bootstrap band.", "",
               "| output | " + " | ".join(f"p = {p}" for p in PROBABILITIES) + " |",
               "|---|" + "---|" * len(PROBABILITIES)]
-        for o in stats.KEY_OUTPUTS:
+        for o in s["worst"]:
             at = s["exceedance"][o]["exceeded_at"]
-            L.append(f"| {o} | " + " | ".join(_fmt(at.get(str(p))) if str(p) in at else "—"
-                                              for p in PROBABILITIES) + " |")
+            L.append(f"| {q[o].label()} | " + " | ".join(
+                q[o].show(at[str(p)]) if str(p) in at else "—" for p in PROBABILITIES) + " |")
+        strength = [(o, s["exceedance"][o]) for o in s["worst"]
+                    if "above_tensile_strength" in s["exceedance"][o]]
+        if strength:
+            ft = strength[0][1]["tensile_strength_Pa"]
+            L += ["", "### Against the concrete's tensile strength", "",
+                  (f"f_t = {three_figures(ft, 1e-6)} MPa." if ft is not None else
+                   "f_t is swept: each scenario is compared with its own.")
+                  + " The probability that an impact takes the stress above it:", ""]
+            for o, c in strength:
+                L.append(f"- {q[o].words}: P[X > f_t | impact] = "
+                         f"{_band(c['above_tensile_strength'])}.")
     numeric = [n for n in inputs if n not in s.get("by_category", {})]
-    L += ["", "## Rank correlation (Spearman) of each output with each numeric input", "",
-          "| output | " + " | ".join(numeric) + " |", "|---|" + "---|" * len(numeric)]
-    for o, d in s["spearman"].items():
-        L.append(f"| {o} | " + " | ".join(_fmt(d[n]) for n in numeric) + " |")
+    if s["spearman"] and numeric:
+        L += ["", "## What drives the design outputs", "",
+              "Spearman's rank correlation of each design output with each numeric input: "
+              "+1 when the output always grows with the input, −1 when it always falls, near "
+              "0 when the input does not matter over its range (— where the input or the "
+              "output did not vary).", "",
+              "| output | " + " | ".join(quantity(n, dim).words for n in numeric) + " |",
+              "|---|" + "---|" * len(numeric)]
+        for o, d in s["spearman"].items():
+            L.append(f"| {q[o].words} | " + " | ".join(
+                "—" if not math.isfinite(d[n]) else f"{d[n]:+.2f}" for n in numeric) + " |")
     for name, table in s.get("by_category", {}).items():
-        L += ["", f"## By `{name}`", "",
+        L += ["", f"## By {quantity(name, dim).words.lower()} (`{name}`)", "",
               "Per category: its scenarios, their median and largest value, and the share "
               "of them above the median and above the value exceeded with probability 0.1 "
               "among all scenarios (1/2 and 1/10 if the category does not matter).", "",
-              "| output | category | n | median | max | P[> median] | P[> 10 % value] |",
+              "| output | category | n | median | largest | P[> median] | P[> 10 % value] |",
               "|---|---|---|---|---|---|---|"]
         for o, cats in table.items():
+            qo = quantity(o, dim)
             for c, d in cats.items():
                 if d["n"]:
-                    L.append(f"| {o} | {c} | {d['n']} | {_fmt(d['median'])} | "
-                             f"{_fmt(d['max'])} | {_fmt(d['p_over_median'])} | "
-                             f"{_fmt(d['p_over_p10'])} |")
+                    L.append(f"| {qo.label()} | {c} | {d['n']} | {qo.show(d['median'])} | "
+                             f"{qo.show(d['max'])} | {three_figures(d['p_over_median'])} | "
+                             f"{three_figures(d['p_over_p10'])} |")
+    if s.get("convergence"):
+        L += ["", "## Mesh convergence of the most unfavourable scenarios", "",
+              "| output | scenario | refine | value | refine + 1 | value | relative change |",
+              "|---|---|---|---|---|---|---|"]
+        for o, c in s["convergence"].items():
+            L.append(f"| {q[o].label()} | {c['id']} | {c['refine']} | {q[o].show(c['value'])} "
+                     f"| {c['refine'] + 1} | {q[o].show(c['value_refined'])} | "
+                     f"{three_figures(100 * c['relative_change'])} % |")
+    L += _computation(s)
+    L += ["", "Figures: " + ", ".join(f"`{p}`" for p in s.get("figures", [])),
+          "", "results.csv and summary.json hold every output of every scenario in SI units "
+          "at full precision.", ""]
+    return "\n".join(L)
+
+
+def _end(base: dict) -> str:
+    """What the log's end does, in one sentence (the force depends on it first)."""
+    if "log_end_crushes" not in base:
+        return ""
+    shape = base.get("log_end_shape", "flat")
+    if base["log_end_crushes"]:
+        return (f"The log's {shape} end crushes at "
+                f"{three_figures(base['wood_crushing_strength_Pa'], 1e-6)} MPa.")
+    return (f"The log's {shape} end does not crush: the forces are the elastic bound of an "
+            "intact log, above what a crushing end transmits.")
+
+
+def _computation(s: dict) -> list:
+    dt = s.get("dt_s")
+    L = ["", "## Computation", "",
+         f"Evaluator `{s['evaluator']}`, engine `{s['engine']}`"
+         + (f", time step {three_figures(dt, 1e6)} µs" if dt is not None else "")
+         + f"; {s['wall_s']:.1f} s this run ({s['computed_this_run']} scenarios computed, "
+         f"{s['scenarios'] - s['computed_this_run']} from an earlier run).", ""]
     c = s["counts"]
     keys = sorted((set(c["factorizations"]) | set(c["back_substitutions"])) - {"total"})
     keys.append("total")
-    L += ["", "## Factorizations and back-substitutions (summed over workers and runs)", "",
+    L += ["Factorizations and back-substitutions, summed over workers and runs:", "",
           "| | " + " | ".join(keys) + " |", "|---|" + "---|" * len(keys)]
     for kind in ("factorizations", "back_substitutions"):
         L.append(f"| {kind.replace('_', '-')} | "
@@ -120,13 +247,4 @@ def markdown(summary: dict, inputs: list) -> str:
         L += ["", "Not in these sums: the evaluator the driving process built to check every "
               f"scenario before computing: factorizations {d['factorizations']}, "
               f"back-substitutions {d['back_substitutions']}."]
-    if s.get("convergence"):
-        L += ["", "## Mesh convergence of the most unfavourable scenarios", "",
-              "| output | id | refine | value | refine + 1 | value | relative change |",
-              "|---|---|---|---|---|---|---|"]
-        for o, c in s["convergence"].items():
-            L.append(f"| {o} | {c['id']} | {c['refine']} | {_fmt(c['value'])} | "
-                     f"{c['refine'] + 1} | {_fmt(c['value_refined'])} | "
-                     f"{_fmt(c['relative_change'])} |")
-    L += ["", "Figures: " + ", ".join(f"`{p}`" for p in s.get("figures", [])), ""]
-    return "\n".join(L)
+    return L
