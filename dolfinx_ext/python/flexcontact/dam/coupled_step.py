@@ -79,10 +79,26 @@ def _log_solve_counter(log):
     return count
 
 
-def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
+AFTER_CONTACT = ("convolve", "step")
+"""How the dam's base section is followed after the last contact step: "convolve" (its
+response functions, dam/response.py: no dam back-substitution) or "step" (the dam stepped
+to the end)."""
+
+
+def run_impact(dam, log, s, static, offset_m: float = 1.0,
+               after_contact: str = "convolve", histories: bool = False) -> dict:
     """The impact of scenario ``s`` (a DamScenario) from the static state ``static`` of
     ``dam`` at its water level, with ``log`` (the LogModel of its log). Returns the outputs
-    (plain floats, see ScenarioEvaluator.evaluate)."""
+    (plain floats, see ScenarioEvaluator.evaluate); with ``histories``, also
+    "history": {section quantity: its change after each step} and "face_impulses".
+
+    ``after_contact="convolve"``: once the log has left the face and the dam's energy
+    cannot bring the face back to it (:func:`_cannot_touch`), the dam is no longer stepped:
+    only the log is, and the base section's history comes from the convolution of the face
+    impulses with its response functions. Should the log come back within that bound, the
+    dam is stepped again from where it stopped (its back-substitutions counted)."""
+    if after_contact not in AFTER_CONTACT:
+        raise ValueError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
     h, theta, d = dam.dt, dam.theta, 2
     R = rotation(s.log_pitch_deg)
     slave = log.placed_front(R, s.log_centre)
@@ -108,17 +124,30 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
     duration = max(approach_time_s(s) + MARGIN * expected_contact_s(s, dam),
                    response_duration_s(s))
     n = int(round(duration / h))
-    records, heel, peak_principal, p_peak = [], -math.inf, -math.inf, 0.0
+    records, peak_principal, p_peak = [], -math.inf, 0.0
+    section = {q: np.zeros(n) for q in dam.section_gradients}
+    impulses = np.zeros((n, dam.face_dofs.size))
     solves0 = (dam.back_substitutions["dam_stage2"], log.back_substitutions)
     stepper = BodiesStepper(kernel, [
         CondensedBody("log", log.factor, log.front_dofs, log.new_vector, rotation=R,
                       counted=_log_solve_counter(log)),
         CondensedBody("dam", dam.factor, dam.face_dofs, dam.new_vector,
                       counted=_dam_solve_counter(dam))], expand_key="velocity_change_c")
+    dam_slice = slice(n_log, n_log + dam.face_dofs.size)   # the kernel's DOFs: log, then dam
+    face_x = pairs.x[m:, 0] + u_face0[0::d]   # the face nodes' static x (m)
+    stopped, touched, last_contact = None, False, -1
     for i in range(n):
         t = i * h
-        u_c = np.concatenate([_log_values(log, bl.w, R, V0 * t),
-                              u_face0 + bd.w.array_r[dam.face_dofs]])
+        u_log = _log_values(log, bl.w, R, V0 * t)
+        if stopped is not None:
+            if _cannot_touch(pairs.x[:m], u_log, _log_values(log, bl.omega, R, V0), face_x,
+                             stopped["bound"], h):
+                bl.advance(_free_log_step(log, bl), h, theta)
+                records.append(SimpleNamespace(t_s=(i + 1) * h, active=0, normal_force=0.0))
+                continue
+            _replay(dam, bd, stopped["step"], i, h, theta, section)  # back to stepping
+            stopped = None
+        u_c = np.concatenate([u_log, u_face0 + bd.w.array_r[dam.face_dofs]])
         v_c = np.concatenate([_log_values(log, bl.omega, R, V0),
                               bd.omega.array_r[dam.face_dofs]])
         rhs = [bl.rhs(), bd.rhs()]
@@ -127,21 +156,87 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0) -> dict:
         for b in rhs:
             if b is not None:
                 b.destroy()
+        impulses[i] = np.asarray(out["reaction"])[dam_slice]
         bd.advance(dv_d, h, theta)
         bl.advance(dv_l, h, theta)
         active = int(np.asarray(out["active"], bool).sum())
         records.append(SimpleNamespace(t_s=(i + 1) * h, active=active,
                                        normal_force=float(out["normal_impulse"]) / h))
         if bd.pushed:
-            heel = max(heel, dam.heel_stress_Pa(static, bd.w))
+            for q, v in dam.section_change(bd.w).items():
+                section[q][i] = v
         if active > 0:
+            touched, last_contact = True, i
             peak_principal = max(peak_principal, dam.peak_principal_Pa(static, bd.w, cells))
             p_peak = max(p_peak, _peak_pressure(out, pairs, h))
+        elif (after_contact == "convolve" and touched and theta == 0.5 and i + 1 < n):
+            bound = np.sqrt(2.0 * max(dam.energy_J(bd.w, bd.omega), 0.0)
+                            * dam.face_compliance(0))
+            stopped = {"step": i + 1, "bound": bound}
+    if stopped is not None:
+        # The base section after the last stepped step, from the whole impulse history.
+        k0 = stopped["step"]
+        conv = dam.responses().convolve(impulses[:last_contact + 1], n)
+        for q in section:
+            section[q][k0:] = conv[q][k0:]
+    heel_static = static.section.sigma_heel_Pa
+    heel = heel_static + float(section["sigma_heel_Pa"].max()) if touched else -math.inf
     out = _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,
                    offset_m, n)
+    out.update(_section_outputs(static, section, touched))
     out["dam_back_substitutions"] = dam.back_substitutions["dam_stage2"] - solves0[0]
     out["log_back_substitutions"] = log.back_substitutions - solves0[1]
+    out["dam_steps_convolved"] = int(n - stopped["step"]) if stopped is not None else 0
+    if histories:
+        out["history"] = section
+        out["face_impulses"] = impulses[:last_contact + 1]
     return out
+
+
+def _section_outputs(static, section: dict, touched: bool) -> dict:
+    """The base section's extremes during the run: the most compressive toe stress and the
+    largest changes of its normal force and moment (static values, no change, if the log
+    never touched)."""
+    toe = static.section.sigma_toe_Pa + (float(section["sigma_toe_Pa"].min()) if touched else 0.0)
+    return {"toe_stress_impact_Pa": min(toe, static.section.sigma_toe_Pa),
+            "base_normal_force_change_N_per_m": float(np.abs(section["normal_force_N"]).max()),
+            "base_moment_change_Nm_per_m": float(np.abs(section["moment_centre_Nm"]).max())}
+
+
+def _cannot_touch(x_log, u_log, v_log, face_x, bound, h: float) -> bool:
+    """Whether the log's front cannot reach the face within the next step: its nodes
+    (reference ``x_log`` + ``u_log``, moving at ``v_log``) stay behind every face node's
+    static x less its energy ``bound``, by two steps of their own motion."""
+    d = x_log.shape[1]
+    front = (x_log[:, 0] + u_log[0::d]).max()
+    reach = 2.0 * h * np.abs(v_log[0::d]).max()
+    return bool(front + reach < (face_x - bound).min())
+
+
+def _free_log_step(log, body):
+    """The log's velocity change in a step without contact (None while it flies rigidly)."""
+    b = body.rhs()
+    if b is None:
+        return None
+    y = log.new_vector()
+    log.factor.solve(b, y)
+    log.back_substitutions += 1
+    b.destroy()
+    return y
+
+
+def _replay(dam, body, first: int, stop: int, h: float, theta: float, section: dict) -> None:
+    """Step the dam alone (no impulse) through steps ``first``..``stop``−1, which were not
+    stepped, recording its section (a re-contact needs its state)."""
+    for k in range(first, stop):
+        b = body.rhs()
+        y = dam.new_vector()
+        dam.factor.solve(b, y)
+        dam.back_substitutions["dam_stage2"] += 1
+        b.destroy()
+        body.advance(y, h, theta)
+        for q, v in dam.section_change(body.w).items():
+            section[q][k] = v
 
 
 def _log_values(log, vec, R, rigid) -> np.ndarray:
@@ -165,6 +260,7 @@ def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_pea
     m = contact_metrics(records, h, filter_window_s=force_filter_window_s(s))
     dp = R @ log.momentum_local(bl.omega)  # the rigid part V₀ keeps its momentum
     static_heel = static.section.sigma_heel_Pa
+    heel = max(heel, static_heel)
     return {
         "peak_force_N_per_m": m["peak_force"],
         "peak_force_filtered_N_per_m": m["peak_force_filtered"],

@@ -53,6 +53,8 @@ from ..errors import InputError, SolveError
 
 STRIP = 1
 """Tag of the face-strip facets in the DamModel's own strip MeshTags."""
+SECTION_QUANTITIES = ("sigma_heel_Pa", "sigma_toe_Pa", "normal_force_N", "moment_centre_Nm")
+"""The base section's quantities whose change is linear in the dam's displacement w."""
 
 
 @dataclass
@@ -198,8 +200,9 @@ class DamModel:
         return setup.unloaded_step_rhs(self.K, self.dt, self.theta, w, omega)
 
     def _heel_functional(self):
-        """g with σ_heel(w) − σ_heel(0) = g·w: the heel stress of the dam's internal nodal
-        forces −K_dam w at the base nodes (linear in w)."""
+        """Gradients g with q(w) − q(0) = g·w of the base section's quantities q (heel and
+        toe stress, normal force, moment about the centre) of the dam's internal nodal
+        forces −K_dam w at the base nodes (each linear in w)."""
         s, V, msh = self.base, self.V, self.mesh.msh
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
         a_dam = dolfinx.fem.form(elasticity_form(u, v, s.concrete, self.dx(T.DAM), self.kind))
@@ -210,19 +213,67 @@ class DamModel:
                                                      ft.indices[ft.values == T.DAM_BASE])
         pts = V.tabulate_dof_coordinates()[blocks, :s.dim]
         B, width = s.base_width_m, 1.0
-        c = K_dam.createVecRight()
-        c.zeroEntries()
-        for k in range(s.dim):
-            unit = np.zeros((len(blocks), s.dim))
-            unit[:, k] = 1.0
-            coeff = [BaseSection.from_forces(p[None, :], f[None, :], B, width).sigma_heel_Pa
-                     for p, f in zip(pts, unit)]
-            c.array[blocks * s.dim + k] = coeff
-        g = K_dam.createVecLeft()
-        K_dam.mult(c, g)
-        self.heel_gradient = -g.array_r.copy()
-        for o in (K_dam, c, g):
-            o.destroy()
+        self.section_gradients = {}
+        for name in SECTION_QUANTITIES:
+            c = K_dam.createVecRight()
+            c.zeroEntries()
+            for k in range(s.dim):
+                unit = np.zeros((len(blocks), s.dim))
+                unit[:, k] = 1.0
+                coeff = [getattr(BaseSection.from_forces(p[None, :], f[None, :], B, width), name)
+                         for p, f in zip(pts, unit)]
+                c.array[blocks * s.dim + k] = coeff
+            g = K_dam.createVecLeft()
+            K_dam.mult(c, g)
+            self.section_gradients[name] = -g.array_r.copy()
+            c.destroy()
+            g.destroy()
+        self.heel_gradient = self.section_gradients["sigma_heel_Pa"]
+        K_dam.destroy()
+
+    def face_compliance(self, axis: int = 0) -> np.ndarray:
+        """(K⁻¹)_ii for the face DOFs i along ``axis`` (m/N, cached): with the dam's energy
+        E (kinetic + strain), |w_i| ≤ sqrt(2 E (K⁻¹)_ii) as long as E does not grow. One
+        back-substitution with K's factor per face node, counted in "dam_response"."""
+        key = f"_compliance_{axis}"
+        if not hasattr(self, key):
+            d = self.base.dim
+            dofs = self.face_dofs[axis::d]
+            e, x = self.new_vector(), self.new_vector()
+            out = np.empty(dofs.size)
+            for j, i in enumerate(dofs):
+                e.zeroEntries()
+                e.array[i] = 1.0
+                self._ksp1.solve(e, x)
+                out[j] = x.array_r[i]
+                self.back_substitutions["dam_response"] = (
+                    self.back_substitutions.get("dam_response", 0) + 1)
+            e.destroy()
+            x.destroy()
+            setattr(self, key, out)
+        return getattr(self, key)
+
+    def energy_J(self, w: PETSc.Vec, omega: PETSc.Vec) -> float:
+        """½ωᵀMω + ½wᵀKw of the motion (w, ω) about the static state (J; J/m in 2D)."""
+        y = self.new_vector()
+        self.M.mult(omega, y)
+        e = 0.5 * omega.dot(y)
+        self.K.mult(w, y)
+        e += 0.5 * w.dot(y)
+        y.destroy()
+        return float(e)
+
+    def responses(self):
+        """The base section's response functions (dam/response.py), made on first use."""
+        if getattr(self, "_responses", None) is None:
+            from .response import ResponseFunctions
+            self._responses = ResponseFunctions(self)
+        return self._responses
+
+    def section_change(self, w: PETSc.Vec) -> dict:
+        """{quantity: its change q(u_static + w) − q(u_static)} of the base section."""
+        x = w.array_r
+        return {k: float(g @ x) for k, g in self.section_gradients.items()}
 
     def heel_stress_Pa(self, static: StaticState, w: Optional[PETSc.Vec]) -> float:
         """Linearised heel stress (Pa, tension positive) of the state u_static + w."""

@@ -24,7 +24,7 @@ from typing import Optional
 from mpi4py import MPI
 
 from .. import impact_setup as setup
-from .coupled_step import expected_contact_s, run_impact
+from .coupled_step import AFTER_CONTACT, expected_contact_s, run_impact
 from .dam_model import DamModel
 from .log_model import LogMesh, LogModel
 from .scenario import DamScenario
@@ -64,13 +64,16 @@ class ScenarioEvaluator:
     ``water_levels_m``: (lowest, highest) water level of the sweep (default: the base's);
     ``comm``: one rank (a parallel sweep runs one evaluator per process); ``strip_m``:
     the elevations of the face strip (default: dam_model.default_strip_m); ``offset_m``:
-    the distance from the first-contact point at which the peak principal stress is read.
+    the distance from the first-contact point at which the peak principal stress is read;
+    ``after_contact``: "convolve" (default: the dam is not stepped once the log has left it
+    for good, the base section then comes from its response functions) or "step".
     """
 
     def __init__(self, base: DamScenario, dt_s: Optional[float] = None,
                  water_levels_m: Optional[tuple[float, float]] = None,
                  comm: MPI.Comm = MPI.COMM_SELF, *,
-                 strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0):
+                 strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0,
+                 after_contact: str = "convolve"):
         if base.dim != 2:
             raise InputError(f"dim={base.dim}: the scenario evaluator is 2D only")
         if base.westergaard:
@@ -79,7 +82,9 @@ class ScenarioEvaluator:
                              "monolithic evaluator (engine.evaluator = \"monolithic\")")
         if not offset_m > 0:
             raise InputError(f"offset_m={offset_m!r}: must be > 0 m")
-        self.base, self.offset_m = base, float(offset_m)
+        if after_contact not in AFTER_CONTACT:
+            raise InputError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
+        self.base, self.offset_m, self.after_contact = base, float(offset_m), after_contact
         self.dt = float(dt_s) if dt_s is not None else sweep_time_step_s([base])
         t0 = time.perf_counter()
         self.dam = DamModel(base, self.dt, water_levels_m, comm, strip_m=strip_m)
@@ -137,7 +142,7 @@ class ScenarioEvaluator:
         log = self.log_model(scenario)
         static = self.dam.static_state(scenario.water_level_m)
         t0 = time.perf_counter()
-        out = run_impact(self.dam, log, scenario, static, self.offset_m)
+        out = run_impact(self.dam, log, scenario, static, self.offset_m, self.after_contact)
         out["evaluate_s"] = time.perf_counter() - t0
         self._steps_s += out["evaluate_s"]
         return out

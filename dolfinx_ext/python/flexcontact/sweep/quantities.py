@@ -84,6 +84,17 @@ def outputs(dim: int) -> dict:
             "run, linearised over the section from its normal force and moment (tension "
             "positive; static load included; never below the static value).", "MPa", 1e-6,
             stress=True),
+        "toe_stress_impact_Pa": Quantity(
+            "Toe stress during impact",
+            "Most compressive vertical stress at the downstream toe of the base section "
+            "during the run, linearised over the section (tension positive; static load "
+            "included; never above the static value).", "MPa", 1e-6),
+        "base_normal_force_change_N_per_m": Quantity(
+            "Base normal force change", f"Largest change of the base section's normal "
+            f"force{of} during the run.", f"MN{per}", 1e-6),
+        "base_moment_change_Nm_per_m": Quantity(
+            "Base moment change", f"Largest change of the base section's moment about its "
+            f"centre{of} during the run.", f"MN·m{per}", 1e-6),
         "heel_stress_static_Pa": Quantity(
             "Static heel stress",
             "Linearised vertical stress at the upstream heel under self-weight and water "

@@ -1,0 +1,93 @@
+"""The base section's response to the face impulses, by the adjoint: after the contact the
+dam need not be stepped (docs/dam.md, "Response functions").
+
+The dam is linear and starts at rest relative to its static state, so each time step of the
+θ-scheme is x⁺ = A x + B P with x = (w, ω) and P the face impulse of the step:
+
+    Δω = Ŵ⁻¹ (−hK (w + hθ ω) + Sᵀ P),   ω⁺ = ω + Δω,   w⁺ = w + hω + hθ Δω.
+
+A quantity q of the base section is linear in w, Δq = g·w, so after step n
+
+    Δq_n = Σ_{k<n} G_{n−1−k} · P_k,   G_j = Bᵀ (Aᵀ)ʲ (g, 0).
+
+G is computed backwards, one output at a time: with λ = (a, b) starting at (g, 0),
+
+    z = Ŵ⁻¹ (hθ a + b),   G_j = S z,   λ ← (a − hKz,  ha + b − h²θ Kz)
+
+(Ŵ and K symmetric): one back-substitution per lag and output, not one forward run per face
+DOF. Only the normal force and the moment about the centre are tabulated: the heel and toe
+stresses are their linear combinations −N/(Bw) ± 6M/(wB²). Stress components, not
+principal stresses, which are not linear.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+TABULATED = ("normal_force_N", "moment_centre_Nm")
+"""The section quantities whose response functions are tabulated."""
+
+
+class ResponseFunctions:
+    """G_j for j < ``n`` of the tabulated quantities of ``dam`` (a DamModel), extended on
+    demand (``ensure(n)``) from the adjoint state where the last extension stopped. Each lag
+    costs one back-substitution with the dam's stage-2 factor, counted in
+    ``dam.back_substitutions["dam_response"]``."""
+
+    def __init__(self, dam):
+        self.dam = dam
+        self.G = {q: np.zeros((0, dam.face_dofs.size)) for q in TABULATED}
+        self._state = {q: None for q in TABULATED}
+        dam.back_substitutions.setdefault("dam_response", 0)
+
+    @property
+    def lags(self) -> int:
+        return self.G[TABULATED[0]].shape[0]
+
+    def ensure(self, n: int) -> None:
+        """Tabulate at least ``n`` lags."""
+        if n <= self.lags:
+            return
+        for q in TABULATED:
+            self.G[q] = np.vstack([self.G[q], self._backward(q, n - self.G[q].shape[0])])
+
+    def _backward(self, q: str, count: int) -> np.ndarray:
+        dam = self.dam
+        h, theta = dam.dt, dam.theta
+        if self._state[q] is None:
+            a, b = dam.new_vector(), dam.new_vector()
+            a.array[:] = dam.section_gradients[q]
+            self._state[q] = (a, b)
+        a, b = self._state[q]
+        rhs, z, Kz = dam.new_vector(), dam.new_vector(), dam.new_vector()
+        out = np.empty((count, dam.face_dofs.size))
+        for j in range(count):
+            rhs.array[:] = h * theta * a.array_r + b.array_r
+            dam.factor.solve(rhs, z)
+            dam.back_substitutions["dam_response"] += 1
+            out[j] = z.array_r[dam.face_dofs]
+            dam.K.mult(z, Kz)
+            a_old = a.array_r.copy()
+            a.array[:] = a_old - h * Kz.array_r
+            b.array[:] = h * a_old + b.array_r - h * h * theta * Kz.array_r
+        for v in (rhs, z, Kz):
+            v.destroy()
+        return out
+
+    def convolve(self, impulses: np.ndarray, n: int) -> dict:
+        """{quantity: Δq after steps 1..n} (arrays of n) for the face impulses
+        ``impulses`` (k × face DOFs: step k's P_k; the steps after them impulse-free), the
+        heel and toe stresses included."""
+        self.ensure(n)
+        P = np.asarray(impulses, float)
+        out = {}
+        for q in TABULATED:
+            C = self.G[q][:n] @ P.T       # C[j, k] = G_j · P_k
+            y = np.zeros(n)
+            for k in range(min(P.shape[0], n)):
+                y[k:] += C[: n - k, k]      # Δq after step i (index i) takes G_{i−k} · P_k
+            out[q] = y
+        B, width = self.dam.base.base_width_m, 1.0
+        N, M = out["normal_force_N"], out["moment_centre_Nm"]
+        out["sigma_heel_Pa"] = -N / (B * width) + 6.0 * M / (width * B * B)
+        out["sigma_toe_Pa"] = -N / (B * width) - 6.0 * M / (width * B * B)
+        return out
