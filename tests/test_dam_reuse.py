@@ -276,3 +276,25 @@ def test_the_energy_bound_holds_on_the_stepped_dam(evaluator):
     for e, w in seen[first:]:
         assert abs(e - E) <= 1e-9 * E
         assert (np.abs(w) <= np.sqrt(2 * E * c) * (1 + 1e-12)).all()
+
+
+def test_a_dam_factor_restored_from_files_steps_the_same_impact(evaluator, tmp_path):
+    """The stepper takes a factor restored from disk (flexcontact.saved_factor) for the
+    dam: Ŵ factored once, saved, restored, and the impact stepped with it equals the run
+    with the dam's own factor (1e-10; two LDLᵀ factors of the same matrix)."""
+    from flexcontact import saved_factor
+    from flexcontact.dam.coupled_step import run_impact
+    dam, s = evaluator.dam, SCENARIOS[1]
+    log, static = evaluator.log_model(s), dam.static_state(s.water_level_m)
+    ref = run_impact(dam, log, s, static, 1.0, "step")
+    entry = saved_factor.save_factor(saved_factor.factor_matrix(dam.W_hat), tmp_path, "What")
+    own = dam.factor
+    dam.factor = saved_factor.restore_factor(tmp_path, entry)
+    try:
+        got = run_impact(dam, log, s, static, 1.0, "step")
+    finally:
+        dam.factor.destroy()
+        dam.factor = own
+    for key in ("peak_force_N_per_m", "impulse_N_s_per_m", "heel_stress_impact_Pa",
+                "toe_stress_impact_Pa", "peak_tensile_stress_Pa", "log_velocity_after_m_s"):
+        assert got[key] == pytest.approx(ref[key], rel=1e-10), key

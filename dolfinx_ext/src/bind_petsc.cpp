@@ -13,6 +13,7 @@
 #include "petsc_caster.h"
 #include "petsc_error.h"
 #include "ordering.h"
+#include "saved_factor.h"
 #include "schur_solve.h"
 
 #include <pybind11/eigen.h>
@@ -117,6 +118,30 @@ void bind_schur_factor(py::module& m)
                throw py::attribute_error(name);
              return py::cast(s.mat(), py::return_value_policy::reference).attr(name.c_str());
            });
+}
+
+void bind_saved_factor(py::module& m)
+{
+  py::class_<SavedFactor>(
+      m, "SavedFactor",
+      "A serial MUMPS LDL^T factor of a symmetric matrix that MUMPS writes to files (save) "
+      "and reads back in another process (SavedFactor.restore): a body factored once is "
+      "never refactored. Use flexcontact.saved_factor, which checks the files first.")
+      .def(py::init<Mat>(), py::arg("A"),
+           "Factor the serial symmetric matrix A (its upper triangle is read)")
+      .def_static(
+          "restore",
+          [](const std::string& dir, const std::string& prefix, PetscInt n)
+          { return std::make_unique<SavedFactor>(dir, prefix, n); },
+          py::arg("dir"), py::arg("prefix"), py::arg("n"),
+          "The factor of n rows that save(dir, prefix) wrote (MUMPS JOB=8)")
+      .def("save", &SavedFactor::save, py::arg("dir"), py::arg("prefix"),
+           "Write the factor as MUMPS's files <dir>/<prefix>_* (JOB=7)")
+      .def("solve", &solve_without_gil<SavedFactor>, py::arg("b"), py::arg("x"),
+           "x = A^-1 b: one back-substitution")
+      .def_property_readonly("size", &SavedFactor::size)
+      .def_property_readonly("factor_entries", &SavedFactor::factor_entries)
+      .def("destroy", &SavedFactor::release, "Release the factor");
 }
 } // namespace
 
@@ -323,6 +348,8 @@ estimated_flops (RINFOG(1)), estimated_memory_mb (INFOG(17)), analysis_s, orderi
 void flexcontact::bind_petsc(py::module& m)
 {
   bind_schur_factor(m);
+  bind_saved_factor(m);
+  m.attr("mumps_version") = MUMPS_VERSION;
   py::handle base = m.attr("SolveError");
   py::register_local_exception<SingularStiffnessError>(m, "SingularStiffnessError", base);
   py::register_local_exception<MumpsError>(m, "MumpsError", base);

@@ -23,5 +23,10 @@ class InputTypeError(FlexcontactError, TypeError):
     """An argument of the wrong kind; the message names it and what was expected."""
 
 
+class SavedFileError(FlexcontactError, ValueError):
+    """A saved file (a factor, a model) that is missing, truncated, altered or of another
+    format or version; the message names the file and what does not match."""
+
+
 class SolveError(FlexcontactError, RuntimeError):
     """A factorization, a contact solve or another computation that failed."""

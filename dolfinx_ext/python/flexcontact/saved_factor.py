@@ -1,0 +1,77 @@
+"""A factor kept on disk: a body factored once is restored in another process instead of
+being factored again (docs/architecture.md §7, "A factor kept on disk").
+
+:func:`save_factor` writes MUMPS's own files (JOB=7) beside a manifest entry that records
+each file's size and SHA-256, the matrix size and the MUMPS version; :func:`restore_factor`
+checks all of it before MUMPS reads a byte (a truncated or altered file would otherwise stop
+the process inside MUMPS's Fortran reader) and restores the factor (JOB=8). The restored
+object has ``solve(b, x)``, so the steppers take it like any factor.
+"""
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from . import _cpp
+from .errors import SavedFileError
+
+FACTOR_FORMAT = 1
+"""The manifest entry's format (the files' own format is MUMPS's, tied to its version)."""
+
+
+def sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def factor_matrix(A) -> "_cpp.SavedFactor":
+    """The LDLᵀ factor of the serial symmetric petsc4py Mat ``A`` (one factorization)."""
+    return _cpp.SavedFactor(A)
+
+
+def save_factor(factor, folder, name: str) -> dict:
+    """Write ``factor`` (a SavedFactor) as ``folder/name_*`` and return its manifest entry:
+    {"name", "rows", "mumps_version", "format", "files": {file: {"bytes", "sha256"}}}."""
+    folder = Path(folder)
+    before = {p.name for p in folder.iterdir()}
+    factor.save(str(folder), name)
+    files = sorted(p for p in folder.iterdir() if p.name not in before
+                   and p.name.startswith(name + "_"))
+    if not files:
+        raise SavedFileError(f"{folder}/{name}: MUMPS wrote no file")
+    return {"name": name, "rows": int(factor.size), "format": FACTOR_FORMAT,
+            "mumps_version": _cpp.mumps_version,
+            "files": {p.name: {"bytes": p.stat().st_size, "sha256": sha256(p)} for p in files}}
+
+
+def check_factor_files(folder, entry: dict) -> None:
+    """SavedFileError naming the first file, format or version that does not match
+    ``entry``."""
+    folder = Path(folder)
+    if entry.get("format") != FACTOR_FORMAT:
+        raise SavedFileError(f"{folder}: factor '{entry.get('name')}' has format "
+                             f"{entry.get('format')!r}; this flexcontact reads {FACTOR_FORMAT}")
+    if entry.get("mumps_version") != _cpp.mumps_version:
+        raise SavedFileError(f"{folder}: factor '{entry['name']}' was saved by MUMPS "
+                             f"{entry.get('mumps_version')}, this build has MUMPS "
+                             f"{_cpp.mumps_version}: factor it again")
+    for name, want in entry["files"].items():
+        path = folder / name
+        if not path.is_file():
+            raise SavedFileError(f"{path}: missing (factor '{entry['name']}')")
+        size = path.stat().st_size
+        if size != want["bytes"]:
+            raise SavedFileError(f"{path}: {size} bytes, {want['bytes']} were saved (a "
+                                 "truncated or replaced file)")
+        if sha256(path) != want["sha256"]:
+            raise SavedFileError(f"{path}: its SHA-256 differs from the saved one (the file "
+                                 "was altered)")
+
+
+def restore_factor(folder, entry: dict) -> "_cpp.SavedFactor":
+    """The factor that :func:`save_factor` wrote (checked first, then one restoration)."""
+    check_factor_files(folder, entry)
+    return _cpp.SavedFactor.restore(str(Path(folder)), entry["name"], int(entry["rows"]))

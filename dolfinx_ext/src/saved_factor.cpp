@@ -1,0 +1,209 @@
+// Copyright flexcontact developers. MIT licence.
+
+#include "saved_factor.h"
+#include "collective.h"
+#include "flexibility.h"
+#include "petsc_error.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+using namespace flexcontact;
+
+namespace
+{
+int& icntl(DMUMPS_STRUC_C& id, int i) { return id.icntl[i - 1]; }
+int infog(const DMUMPS_STRUC_C& id, int i) { return id.infog[i - 1]; }
+} // namespace
+
+void SavedFactor::init()
+{
+  id_.job = -1;
+  id_.par = 1;
+  id_.sym = 2; // symmetric LDLᵀ with pivoting: Ŵ and K need not be definite on held rows
+  id_.comm_fortran = static_cast<int>(MPI_Comm_c2f(MPI_COMM_SELF));
+  dmumps_c(&id_);
+  if (infog(id_, 1) < 0)
+    throw_mumps_error("initialization", infog(id_, 1), infog(id_, 2));
+  alive_ = true;
+  icntl(id_, 1) = icntl(id_, 2) = icntl(id_, 3) = -1; // no printing
+  icntl(id_, 4) = 0;
+  icntl(id_, 5) = 0;  // assembled
+  icntl(id_, 18) = 0; // centralised triplets
+  icntl(id_, 20) = 0; // dense right-hand side
+  icntl(id_, 21) = 0; // centralised solution
+  icntl(id_, 24) = 1; // detect null pivots instead of dividing by ~0
+}
+
+SavedFactor::SavedFactor(Mat A)
+{
+  PetscErrorScope err;
+  PetscInt rows = 0, cols = 0;
+  err.check(MatGetSize(A, &rows, &cols), "MatGetSize");
+  int size = 1;
+  MPI_Comm_size(PetscObjectComm(reinterpret_cast<PetscObject>(A)), &size);
+  if (size != 1)
+    throw std::invalid_argument("SavedFactor: the matrix is distributed over "
+                                + std::to_string(size) + " processes; it must be serial");
+  if (rows != cols or rows < 1 or rows > std::numeric_limits<int>::max() - 1)
+    throw std::invalid_argument("SavedFactor: a square matrix of 1 to 2^31 - 2 rows is needed, "
+                                "not " + std::to_string(rows) + " x " + std::to_string(cols));
+  n_ = rows;
+  err.check(MatGetRowUpperTriangular(A), "MatGetRowUpperTriangular");
+  for (PetscInt r = 0; r < n_; ++r)
+  {
+    PetscInt nc = 0;
+    const PetscInt* c = nullptr;
+    const PetscScalar* v = nullptr;
+    err.check(MatGetRow(A, r, &nc, &c, &v), "MatGetRow");
+    for (PetscInt k = 0; k < nc; ++k)
+      if (c[k] >= r)
+      {
+        irn_.push_back(static_cast<int>(r + 1));
+        jcn_.push_back(static_cast<int>(c[k] + 1));
+        a_.push_back(v[k]);
+      }
+    err.check(MatRestoreRow(A, r, &nc, &c, &v), "MatRestoreRow");
+  }
+  err.check(MatRestoreRowUpperTriangular(A), "MatRestoreRowUpperTriangular");
+  init();
+  try
+  {
+    id_.n = static_cast<int>(n_);
+    id_.nnz = static_cast<MUMPS_INT8>(a_.size());
+    id_.nz = a_.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max())
+                 ? static_cast<int>(a_.size()) : 0;
+    id_.irn = irn_.data();
+    id_.jcn = jcn_.data();
+    id_.a = a_.data();
+    call(1, "analysis");
+    for (int retries = 0;; ++retries)
+    {
+      id_.job = 2;
+      dmumps_c(&id_);
+      const int e = infog(id_, 1);
+      if ((e == -8 or e == -9) and retries < 5)
+      {
+        icntl(id_, 14) = std::max(2 * icntl(id_, 14), 50); // pivoting outgrew the estimate
+        continue;
+      }
+      if (e < 0)
+        throw_mumps_error("factorization", e, infog(id_, 2));
+      break;
+    }
+    throw_if_null_pivots(infog(id_, 28));
+  }
+  catch (...)
+  {
+    release();
+    throw;
+  }
+  // MUMPS holds the factor; the triplets are not needed for solves.
+  std::vector<int>().swap(irn_);
+  std::vector<int>().swap(jcn_);
+  std::vector<double>().swap(a_);
+  id_.irn = id_.jcn = nullptr;
+  id_.a = nullptr;
+}
+
+SavedFactor::SavedFactor(const std::string& dir, const std::string& prefix, PetscInt n)
+{
+  if (n < 1 or n > std::numeric_limits<int>::max() - 1)
+    throw std::invalid_argument("SavedFactor: n=" + std::to_string(n) + " rows is not a size");
+  n_ = n;
+  init();
+  try
+  {
+    set_files(dir, prefix);
+    call(8, "restoration of '" + dir + "/" + prefix + "'");
+    if (id_.n != static_cast<int>(n_))
+      throw std::invalid_argument("SavedFactor: the files at '" + dir + "/" + prefix
+                                  + "' hold a factor of " + std::to_string(id_.n)
+                                  + " rows, not " + std::to_string(n_));
+  }
+  catch (...)
+  {
+    release();
+    throw;
+  }
+}
+
+SavedFactor::~SavedFactor() { release(); }
+
+void SavedFactor::release()
+{
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (alive_ and !finalized)
+  {
+    id_.job = -2;
+    dmumps_c(&id_);
+  }
+  alive_ = false;
+}
+
+void SavedFactor::set_files(const std::string& dir, const std::string& prefix)
+{
+  if (dir.size() >= sizeof(id_.save_dir) or prefix.size() >= sizeof(id_.save_prefix))
+    throw std::invalid_argument("SavedFactor: the folder '" + dir + "' or the prefix '" + prefix
+                                + "' is longer than MUMPS takes ("
+                                + std::to_string(sizeof(id_.save_dir) - 1) + " and "
+                                + std::to_string(sizeof(id_.save_prefix) - 1) + " characters)");
+  std::memset(id_.save_dir, 0, sizeof(id_.save_dir));
+  std::memset(id_.save_prefix, 0, sizeof(id_.save_prefix));
+  std::memcpy(id_.save_dir, dir.data(), dir.size());
+  std::memcpy(id_.save_prefix, prefix.data(), prefix.size());
+}
+
+void SavedFactor::save(const std::string& dir, const std::string& prefix)
+{
+  if (!alive_)
+    throw std::runtime_error("SavedFactor: the factor was released");
+  set_files(dir, prefix);
+  call(7, "save to '" + dir + "/" + prefix + "'");
+}
+
+void SavedFactor::solve(Vec b, Vec x)
+{
+  if (!alive_)
+    throw std::runtime_error("SavedFactor: the factor was released");
+  PetscErrorScope err;
+  PetscInt nb = 0, nx = 0;
+  err.check(VecGetSize(b, &nb), "VecGetSize(b)");
+  err.check(VecGetSize(x, &nx), "VecGetSize(x)");
+  if (nb != n_ or nx != n_)
+    throw std::invalid_argument("SavedFactor.solve: b has " + std::to_string(nb) + " and x "
+                                + std::to_string(nx) + " entries; the factor has "
+                                + std::to_string(n_) + " rows");
+  rhs_.resize(n_);
+  const PetscScalar* pb = nullptr;
+  err.check(VecGetArrayRead(b, &pb), "VecGetArrayRead");
+  std::copy(pb, pb + n_, rhs_.begin());
+  err.check(VecRestoreArrayRead(b, &pb), "VecRestoreArrayRead");
+  id_.nrhs = 1;
+  id_.lrhs = static_cast<int>(n_);
+  id_.rhs = rhs_.data();
+  call(3, "solve");
+  PetscScalar* px = nullptr;
+  err.check(VecGetArray(x, &px), "VecGetArray");
+  std::copy(rhs_.begin(), rhs_.end(), px);
+  err.check(VecRestoreArray(x, &px), "VecRestoreArray");
+}
+
+double SavedFactor::factor_entries() const
+{
+  const int e = infog(id_, 29) != 0 ? infog(id_, 29) : infog(id_, 20);
+  return e >= 0 ? e : -static_cast<double>(e) * 1e6;
+}
+
+void SavedFactor::call(int job, const std::string& phase)
+{
+  id_.job = job;
+  dmumps_c(&id_);
+  if (infog(id_, 1) < 0)
+    throw_mumps_error(phase.c_str(), infog(id_, 1), infog(id_, 2));
+}
