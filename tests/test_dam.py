@@ -264,8 +264,11 @@ def test_demo_serial_and_two_ranks_agree(tmp_path):
     assert abs(imp["sigma_heel_before_Pa"] - ref["sigma_heel_Pa"]) <= STATICS_RTOL * 1e5
     report = (folder / "report.md").read_text()
     for heading in ("## Scenario", "## Limits of the model", "## Stage 1", "## Stage 2",
-                    "## Mesh study", "## Figures"):
+                    "## Against design practice", "## Mesh study", "## Figures"):
         assert heading in report, heading
+    # The model's force in the design table: the filtered peak × D (2D), three figures.
+    D = serial["scenario"]["log_diameter_m"]
+    assert f"| {imp['peak_force_filtered'] * D / 1e6:.3g} |" in report
     assert (folder / "impact_stresses.png").is_file()
     assert (folder / "impact_peak.xdmf").is_file()
     # The picture, or the reason it is missing.

@@ -106,3 +106,29 @@ def test_comparison_demo_in_2d(tmp_path):
         assert crushing <= s.wood_crushing_strength_Pa * D, (end, crushing)
         assert row[f"crush_depth_{end}_m"] > 0, end
         assert rows[0][f"contact_ended_crushing_{end}"] == "True", end
+
+
+def test_the_main_reports_comparison_is_each_formula_and_its_stiffness():
+    """comparison(): each formula at the scenario's log and speed; k_eff = F²/(m v²), the
+    model's with the added mass and a formula's with the log's own mass, so that Haehnel &
+    Daly's is their 2.4 MN/m and the elastic bar's EA/L, exactly; the 2D force scaled by
+    the log's diameter."""
+    from flexcontact.dam import DamScenario
+    for dim in (2, 3):
+        s = DamScenario(dim=dim)
+        m = s.log_mass_kg()
+        c = dfm.comparison(s.as_dict(), m, 1.0e6)
+        v = s.log_speed_m_s
+        assert c["formulas_N"] == dfm.all_formulas_N(m, v, s.log_diameter_m, s.log_length_m,
+                                                     s.wood.E_Pa, s.wood.rho_kg_m3,
+                                                     s.wood_crushing_strength_Pa)
+        width = s.log_diameter_m if dim == 2 else 1.0
+        assert c["model_N"] == 1.0e6 * width
+        m_eff = m * (1 + s.added_mass_coefficient)
+        assert c["k_eff_N_m"]["model"] == pytest.approx((1e6 * width) ** 2 / (m_eff * v * v),
+                                                        rel=1e-14)
+        assert c["k_eff_N_m"]["haehnel_daly"] == pytest.approx(dfm.HAEHNEL_DALY_STIFFNESS_N_M,
+                                                               rel=1e-14)
+        area = math.pi * s.log_diameter_m ** 2 / 4
+        assert c["k_eff_N_m"]["eurocode_bar"] == pytest.approx(
+            s.wood.E_Pa * area / s.log_length_m, rel=1e-14)

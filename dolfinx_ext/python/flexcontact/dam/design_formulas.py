@@ -107,3 +107,38 @@ def all_formulas_N(m_kg: float, v_m_s: float, diameter_m: float, length_m: float
         "matsutomi": matsutomi_force_N(diameter_m, length_m, v_m_s,
                                        density_kg_m3 * G_M_S2, yield_stress_Pa),
     }
+
+
+FORMULA_NAMES = {"asce7": "ASCE 7 / FEMA P-55 (impulse over Δt = 0.03 s)",
+                 "haehnel_daly": "Haehnel & Daly (spring k = 2.4 MN/m)",
+                 "eurocode_bar": "EN 1991-1-7 Annex C (log as an elastic bar, k = EA/L)",
+                 "matsutomi": "Matsutomi (1999), driftwood fit"}
+
+
+def effective_stiffness_N_m(force_N: float, m_kg: float, v_m_s: float) -> float:
+    """k_eff = F²/(m v²): the linear spring that gives the peak force F for a mass m striking
+    at v (F = v √(k m)), the common measure of the formulas and the model."""
+    return force_N * force_N / (m_kg * v_m_s * v_m_s)
+
+
+def comparison(scenario: dict, mass_kg: float, peak_force_filtered: float) -> dict:
+    """The model's filtered peak force of one impact beside every formula for the same log
+    and speed, with k_eff for each: {"model_N", "width_m", "mass_kg", "speed_m_s",
+    "formulas_N": {...}, "k_eff_N_m": {"model": …, formula: …}}. ``scenario`` is
+    DamScenario.as_dict() and ``mass_kg`` the log's mass (its end's shape included); in 2D
+    the force per metre is multiplied by the log's diameter (the width one log occupies: a
+    rough conversion). The model's k_eff uses the mass with the added mass, as the model's
+    log moves it; a formula's, the log's own mass, as its source does (Haehnel & Daly's is
+    then its 2.4 MN/m)."""
+    s = scenario
+    D, L, v = s["log_diameter_m"], s["log_length_m"], s["log_speed_m_s"]
+    rho, m = s["wood"]["rho_kg_m3"], float(mass_kg)
+    m_eff = m * (1.0 + s["added_mass_coefficient"])
+    width = 1.0 if s["dim"] == 3 else D
+    model = peak_force_filtered * width
+    formulas = all_formulas_N(m, v, D, L, s["wood"]["E_Pa"], rho,
+                              s["wood_crushing_strength_Pa"])
+    k = {"model": effective_stiffness_N_m(model, m_eff, v)}
+    k.update({name: effective_stiffness_N_m(f, m, v) for name, f in formulas.items()})
+    return {"model_N": model, "width_m": width, "mass_kg": m, "mass_with_added_kg": m_eff,
+            "speed_m_s": v, "formulas_N": formulas, "k_eff_N_m": k}

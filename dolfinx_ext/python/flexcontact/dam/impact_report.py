@@ -146,6 +146,39 @@ def _stage2(st2: dict, u: dict) -> list:
         f"contact point: {_mpa(st2['peak_max_principal_stress_near_impact_Pa'])} MPa.", ""]
 
 
+def _design(s: dict, log: dict, st2: dict) -> list:
+    """The model's force beside the design formulas for the same log and speed."""
+    from .design_formulas import FORMULA_NAMES, comparison
+    c = comparison(s, log["mass_kg"], st2["peak_force_filtered"])
+    k, F = c["k_eff_N_m"], c["formulas_N"]
+    end = ("its end crushing" if st2.get("log_end_crushes") else
+           "its end elastic (the upper bound)")
+    out = ["## Against design practice", "",
+           f"The same log ({c['mass_kg']:.0f} kg, {c['speed_m_s']:g} m/s) in the published "
+           "debris-impact formulas (`flexcontact.dam.design_formulas`), and the spring "
+           "stiffness each implies, k_eff = F²/(m v²) (the model's with the added mass it "
+           "moves, the formulas' with the log's own mass)"
+           + (f"; the 2D model's force per metre is multiplied by the log's diameter "
+              f"({c['width_m']:g} m), a rough conversion" if s["dim"] == 2 else "") + ".", "",
+           "| | peak force [MN] | k_eff [MN/m] | model / formula |", "|---|---|---|---|",
+           f"| this model, filtered peak, {end} | {c['model_N'] / 1e6:.3g} | "
+           f"{k['model'] / 1e6:.3g} | 1 |"]
+    for name, words in FORMULA_NAMES.items():
+        out.append(f"| {words} | {F[name] / 1e6:.3g} | {k[name] / 1e6:.3g} | "
+                   f"{c['model_N'] / F[name]:.2g} |")
+    bar = c["model_N"] / F["eurocode_bar"]
+    out += ["", f"The elastic bar's force A√(Eρ)·v is what an intact flat end sends into a "
+            f"rigid wall; the model gives {bar:.2g} of it"
+            + (": the crushing end caps the pressure where the log touches, and the force "
+               "grows only as the crushed patch widens." if st2.get("log_end_crushes") else
+               ".")
+            + " Haehnel & Daly's stiffness was measured on full-scale logs striking end-on, "
+            "with their ends as they were; ASCE 7 takes the log's momentum over 0.03 s. "
+            "`demos/dam_design_formulas.py` runs the whole table over lengths and speeds "
+            "(docs/dam.md, design formulas).", ""]
+    return out
+
+
 def _mesh_study(rows: list) -> list:
     out = ["## Mesh study", "",
            "| h impact [m] | h far [m] | cells | "
@@ -193,7 +226,7 @@ def write_report(folder, summary: dict, mesh_study: list | None = None,
              "positive" + (", per metre of dam" if s["dim"] == 2 else "") + ").", ""]
     lines += _scenario(s, summary["log"]) + _limits(st2, bool(s.get("westergaard")), s["dim"]) + _stage1(st1, unit)
     if st2:
-        lines += _stage2(st2, unit)
+        lines += _stage2(st2, unit) + _design(s, summary["log"], st2)
     if mesh_study:
         lines += _mesh_study(mesh_study)
     else:
