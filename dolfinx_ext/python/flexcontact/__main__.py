@@ -1,5 +1,7 @@
 """`python3 -m flexcontact info` prints the stack flexcontact runs on; `demos` lists demos;
-`sweep CONFIG.toml` runs a sweep of dam-impact scenarios (docs/dam.md, "Sweeps")."""
+`sweep CONFIG.toml` runs a sweep of dam-impact scenarios (docs/dam.md, "Sweeps"); `dam
+prepare CONFIG.toml` saves a factored dam and `dam what-if MODEL --log-speed-m-s 3 ...`
+answers one scenario from it (docs/dam.md, "A dam model file")."""
 import argparse
 import json
 from pathlib import Path
@@ -14,7 +16,12 @@ def main(argv=None):
     sub.add_parser("demos", help="list the demos and how to run them")
     from .sweep.cli import add_parser as add_sweep
     add_sweep(sub)
+    from .dam.cli import add_parser as add_dam
+    add_dam(sub)
     args = ap.parse_args(argv)
+    if args.cmd == "dam":
+        from .dam.cli import main as dam
+        raise SystemExit(dam(args))
     if args.cmd == "sweep":
         from .sweep.cli import main as sweep
         raise SystemExit(sweep(args))

@@ -44,6 +44,15 @@ def expected_contact_s(s, dam) -> float:
     return min(2.0 * extent / c_log, 2.0 * s.base_width_m / c_dam)
 
 
+def run_steps(s, dam) -> int:
+    """Time steps of scenario ``s``'s run: long enough for the base, whose moment peaks about
+    half the dam's first period after the impact, well after the contact has ended
+    (stage2.response_duration_s)."""
+    duration = max(approach_time_s(s) + MARGIN * expected_contact_s(s, dam),
+                   response_duration_s(s))
+    return int(round(duration / dam.dt))
+
+
 class _Body:
     """Displacement w and velocity ω of one body (PETSc Vecs), at rest until pushed."""
 
@@ -119,11 +128,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     u_face0 = static.u.x.array[dam.face_dofs]
     impact = np.array([0.0, s.log_front_point[-1]])
     cells = dam.stress_cells(impact, offset_m)
-    # Long enough for the base: its moment peaks about half the dam's first period after
-    # the impact, well after the contact has ended (stage2.response_duration_s).
-    duration = max(approach_time_s(s) + MARGIN * expected_contact_s(s, dam),
-                   response_duration_s(s))
-    n = int(round(duration / h))
+    n = run_steps(s, dam)
     records, peak_principal, p_peak = [], -math.inf, 0.0
     section = {q: np.zeros(n) for q in dam.section_gradients}
     impulses = np.zeros((n, dam.face_dofs.size))

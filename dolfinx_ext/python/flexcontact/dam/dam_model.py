@@ -92,7 +92,7 @@ class DamModel:
     """
 
     def __init__(self, base, dt_s: float, water_levels_m=None, comm=MPI.COMM_SELF,
-                 strip_m=None, theta: float = 0.5):
+                 strip_m=None, theta: float = 0.5, restored: Optional[dict] = None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: DamModel is serial (one rank; "
                              "parallel sweeps run one DamModel per process)")
@@ -101,7 +101,12 @@ class DamModel:
         self.base, self.dt, self.theta, self.comm = base, float(dt_s), float(theta), comm
         self.water_levels_m = (lo, hi)
         self.strip_m = tuple(strip_m) if strip_m is not None else default_strip_m(base, (lo, hi))
+        # restored: {"stage1": factor of K, "stage2": factor of Ŵ, "W_face": array} read
+        # from a model file (dam/model_file.py): nothing is factored, the restorations are
+        # counted instead.
+        self._restored = restored
         self.factorizations = {"dam_stage1": 0, "dam_stage2": 0}
+        self.restorations = {"dam_stage1": 0, "dam_stage2": 0}
         self.back_substitutions = {"dam_stage1": 0, "dam_stage2": 0}
         self.timings = {}
         t0 = time.perf_counter()
@@ -126,6 +131,12 @@ class DamModel:
         self.a_form = dolfinx.fem.form(elasticity_form(u, v, self.materials, self.dx, self.kind,
                                                        cell_tags=self.mesh.cell_tags))
         K1 = assemble_stiffness(self.a_form, self.bcs)
+        self._K1 = K1
+        if self._restored is not None:
+            self._ksp1, self._factor1 = None, self._restored["stage1"]
+            self.restorations["dam_stage1"] += 1
+            self.timings["stage1_factor_s"] = time.perf_counter() - t0
+            return
         ksp = PETSc.KSP().create(K1.getComm())
         ksp.setOperators(K1)
         ksp.setType("preonly")
@@ -133,7 +144,7 @@ class DamModel:
         ksp.getPC().setFactorSolverType("mumps")
         ksp.setUp()  # the one numerical factorization of K
         self.factorizations["dam_stage1"] += 1
-        self._K1, self._ksp1 = K1, ksp
+        self._ksp1, self._factor1 = ksp, None
         self.timings["stage1_factor_s"] = time.perf_counter() - t0
 
     def static_state(self, water_level_m: float) -> StaticState:
@@ -148,9 +159,7 @@ class DamModel:
                           self.bcs, self.comm)
         uh = dolfinx.fem.Function(self.V, name="displacement_m")
         x = compat.petsc_vec(uh)
-        self._ksp1.solve(p, x)
-        if self._ksp1.getConvergedReason() < 0:
-            raise SolveError(f"stage 1 at water_level_m={key}: the MUMPS solve failed")
+        self._solve1(p, x, f"stage 1 at water_level_m={key}")
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         p.destroy()
         self.back_substitutions["dam_stage1"] += 1
@@ -158,6 +167,15 @@ class DamModel:
         state = StaticState(key, uh, dam, found)
         self._statics[key] = state
         return state
+
+    def _solve1(self, b: PETSc.Vec, x: PETSc.Vec, what: str) -> None:
+        """x = K⁻¹ b with stage 1's factor (its own, or the one restored from a file)."""
+        if self._factor1 is not None:
+            self._factor1.solve(b, x)
+            return
+        self._ksp1.solve(b, x)
+        if self._ksp1.getConvergedReason() < 0:
+            raise SolveError(f"{what}: the MUMPS solve failed")
 
     # ---- stage 2 -------------------------------------------------------------------------
     def _stage2(self):
@@ -173,10 +191,19 @@ class DamModel:
         self.strip_tags = self._strip_tags()
         self.face = _candidate_surface(self.V, self.strip_tags, STRIP)
         self.face_dofs = np.asarray(self.face["dofs"], np.int64).reshape(-1)
-        F, self.factor, info = _cpp.flexibility(self.W_hat, self.face_dofs, "schur")
-        self.W_face = np.asarray(F)
-        self.factorizations["dam_stage2"] += int(info["factorizations"])
-        self.flex_info = dict(info)
+        if self._restored is not None:
+            self.factor = self._restored["stage2"]
+            self.W_face = np.asarray(self._restored["W_face"])
+            if self.W_face.shape != (self.face_dofs.size,) * 2:
+                raise SolveError(f"W_face of shape {self.W_face.shape} restored for a face of "
+                                 f"{self.face_dofs.size} DOFs")
+            self.restorations["dam_stage2"] += 1
+            self.flex_info = {"restored": True}
+        else:
+            F, self.factor, info = _cpp.flexibility(self.W_hat, self.face_dofs, "schur")
+            self.W_face = np.asarray(F)
+            self.factorizations["dam_stage2"] += int(info["factorizations"])
+            self.flex_info = dict(info)
         self.timings["stage2_factor_s"] = time.perf_counter() - t0
 
     def _strip_tags(self):
@@ -244,7 +271,7 @@ class DamModel:
             for j, i in enumerate(dofs):
                 e.zeroEntries()
                 e.array[i] = 1.0
-                self._ksp1.solve(e, x)
+                self._solve1(e, x, "the face's compliance")
                 out[j] = x.array_r[i]
                 self.back_substitutions["dam_response"] = (
                     self.back_substitutions.get("dam_response", 0) + 1)
@@ -303,8 +330,25 @@ class DamModel:
         return float(np.max(vals))
 
     def counts(self) -> dict:
-        return {"factorizations": dict(self.factorizations),
-                "back_substitutions": dict(self.back_substitutions)}
+        out = {"factorizations": dict(self.factorizations),
+               "back_substitutions": dict(self.back_substitutions)}
+        if any(self.restorations.values()):
+            out["restorations"] = dict(self.restorations)
+        return out
+
+    def mesh_hash(self) -> str:
+        """SHA-256 of what the saved operators are numbered by: the node coordinates, the
+        cells, the DOFs of the face strip and the cell tags (a model file is refused if the
+        mesh rebuilt in another process differs)."""
+        import hashlib
+        h = hashlib.sha256()
+        msh = self.mesh.msh
+        for a in (compat.geometry_x(msh), compat.geometry_dofmap(msh), self.face_dofs,
+                  self.mesh.cell_tags.indices, self.mesh.cell_tags.values):
+            a = np.ascontiguousarray(a)
+            h.update(str((a.dtype.str, a.shape)).encode())
+            h.update(a.tobytes())
+        return h.hexdigest()
 
 
 def _levels(base, water_levels_m) -> tuple[float, float]:

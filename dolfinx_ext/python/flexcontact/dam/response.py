@@ -48,7 +48,32 @@ class ResponseFunctions:
         if n <= self.lags:
             return
         for q in TABULATED:
-            self.G[q] = np.vstack([self.G[q], self._backward(q, n - self.G[q].shape[0])])
+            if self._state[q] is None:
+                # Tabulated elsewhere (a model file) without the adjoint state to go on
+                # from: start again from lag 0.
+                self.G[q] = self._backward(q, n)
+            else:
+                self.G[q] = np.vstack([self.G[q], self._backward(q, n - self.G[q].shape[0])])
+
+    def saved(self) -> dict:
+        """The tabulated G and the adjoint state to go on from, as arrays (a model file)."""
+        out = {}
+        for q in TABULATED:
+            out[f"G_{q}"] = self.G[q]
+            if self._state[q] is not None:
+                out[f"adjoint_a_{q}"] = self._state[q][0].array_r.copy()
+                out[f"adjoint_b_{q}"] = self._state[q][1].array_r.copy()
+        return out
+
+    def restore(self, arrays: dict) -> None:
+        """Take the G and adjoint state of :meth:`saved` (extension goes on from them)."""
+        for q in TABULATED:
+            self.G[q] = np.asarray(arrays[f"G_{q}"])
+            if f"adjoint_a_{q}" in arrays:
+                a, b = self.dam.new_vector(), self.dam.new_vector()
+                a.array[:] = arrays[f"adjoint_a_{q}"]
+                b.array[:] = arrays[f"adjoint_b_{q}"]
+                self._state[q] = (a, b)
 
     def _backward(self, q: str, count: int) -> np.ndarray:
         dam = self.dam

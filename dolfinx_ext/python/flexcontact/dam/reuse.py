@@ -73,7 +73,7 @@ class ScenarioEvaluator:
                  water_levels_m: Optional[tuple[float, float]] = None,
                  comm: MPI.Comm = MPI.COMM_SELF, *,
                  strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0,
-                 after_contact: str = "convolve"):
+                 after_contact: str = "convolve", dam: Optional[DamModel] = None):
         if base.dim != 2:
             raise InputError(f"dim={base.dim}: the scenario evaluator is 2D only")
         if base.westergaard:
@@ -85,9 +85,13 @@ class ScenarioEvaluator:
         if after_contact not in AFTER_CONTACT:
             raise InputError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
         self.base, self.offset_m, self.after_contact = base, float(offset_m), after_contact
-        self.dt = float(dt_s) if dt_s is not None else sweep_time_step_s([base])
+        self.dt = (dam.dt if dam is not None else
+                   float(dt_s) if dt_s is not None else sweep_time_step_s([base]))
         t0 = time.perf_counter()
-        self.dam = DamModel(base, self.dt, water_levels_m, comm, strip_m=strip_m)
+        # dam: a DamModel already built for this base and time step (restored from a model
+        # file, dam/model_file.py); otherwise it is built and factored here.
+        self.dam = dam if dam is not None else DamModel(base, self.dt, water_levels_m, comm,
+                                                        strip_m=strip_m)
         self.dam.static_state(base.water_level_m)
         self._logs: dict = {}
         self._steps_s = self._log_mesh_s = 0.0

@@ -135,6 +135,20 @@ class DamScenario:
         """A copy with some parameters changed (checked again)."""
         return replace(self, **changes)
 
+    @classmethod
+    def from_dict(cls, d: dict) -> DamScenario:
+        """The scenario of :meth:`as_dict`'s output (materials keep their default names)."""
+        kwargs = {}
+        for f in fields(cls):
+            if f.name not in d:
+                continue
+            v = d[f.name]
+            if isinstance(f.default, Material):
+                v = Material(E_Pa=v["E_Pa"], nu=v["nu"], rho_kg_m3=v["rho_kg_m3"],
+                             name=f.default.name)
+            kwargs[f.name] = v
+        return cls(**kwargs)
+
     def as_dict(self) -> dict:
         """Plain parameters for a summary (materials as dicts)."""
         out = {}

@@ -143,7 +143,7 @@ def total_counts(rows: list) -> dict:
     for r in rows:
         for kind, d in r.get("counts", {}).items():
             for k, v in d.items():
-                tot[kind][k] = tot[kind].get(k, 0) + int(v)
+                tot.setdefault(kind, {})[k] = tot.setdefault(kind, {}).get(k, 0) + int(v)
     for kind in list(tot):
         tot[kind]["total"] = sum(v for k, v in tot[kind].items() if k != "total")
     return tot

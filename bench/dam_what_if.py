@@ -1,0 +1,57 @@
+"""What a what-if question costs once the dam is saved (dam/model_file.py).
+
+Prepares the dam model of ``examples/sweep_small.toml`` (the 2D section at its default
+mesh), then runs ``python3 -m flexcontact dam what-if MODEL ...`` ``--runs`` times, each a
+new process, on the same scenario, and records in one run: the whole command's wall time,
+the time to load the model and to answer (from the command's own --json), the counts
+(nothing of the dam factored), and the machine's load. Writes bench/dam_what_if.json.
+
+    /usr/bin/python3 bench/dam_what_if.py [--runs 5]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+ap = argparse.ArgumentParser(description=__doc__)
+ap.add_argument("--runs", type=int, default=5)
+ap.add_argument("--out", default=str(Path(__file__).with_name("dam_what_if.json")))
+args = ap.parse_args()
+sys.path.insert(0, str(ROOT / "bench"))
+from machine import machine  # noqa: E402
+
+ASK = ["--log-speed-m-s", "3", "--log-pitch-deg", "10", "--log-length-m", "12",
+       "--water-level-m", "26"]
+with tempfile.TemporaryDirectory() as tmp:
+    model = Path(tmp) / "model"
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "flexcontact", "dam", "prepare",
+                    str(ROOT / "examples" / "sweep_small.toml"), "--out", str(model)],
+                   check=True, cwd=ROOT, capture_output=True)
+    prepare_s = time.perf_counter() - t0
+    runs = []
+    for _ in range(args.runs):
+        t0 = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "flexcontact", "dam", "what-if", str(model),
+                            *ASK, "--json"], check=True, cwd=ROOT, capture_output=True,
+                           text=True)
+        wall = time.perf_counter() - t0
+        out = json.loads(r.stdout)
+        runs.append({"command_s": wall, **{f"{k}_s": v for k, v in out["seconds"].items()},
+                     "counts": out["counts"]})
+    size = sum(p.stat().st_size for p in model.iterdir())
+result = {
+    "what": "dam what-if from a saved model, 2D section at its default mesh",
+    "config": "examples/sweep_small.toml", "scenario": ASK, "prepare_s": prepare_s,
+    "model_bytes": size, "runs": runs,
+    "median_s": {k: statistics.median(r[k] for r in runs)
+                 for k in ("command_s", "load_s", "evaluate_s")},
+    "load_average_1min": os.getloadavg()[0], "machine": machine()}
+Path(args.out).write_text(json.dumps(result, indent=1))
+print(json.dumps(result["median_s"]), f"prepare {prepare_s:.1f} s, model {size / 1e6:.1f} MB")

@@ -1,0 +1,218 @@
+"""A factored dam saved once, loaded in a new process to answer scenarios without factoring
+it again (docs/dam.md, "A dam model file").
+
+The model is one directory, written atomically (complete or absent):
+
+* ``manifest.json``: the format, the flexcontact version, the inputs (the base scenario,
+  the time step, the water-level range, the face strip) and their SHA-256, the hash of the
+  dam's mesh, and the size and SHA-256 of every other file;
+* ``arrays.npz``: the face's condensed flexibility W_face, the base section's response
+  functions (dam/response.py), the face compliance of the re-contact bound, and the static
+  displacement of each water level it was asked for;
+* MUMPS's own files of the two factors, K (stage 1: another water level in the range is one
+  back-substitution) and Ŵ (stage 2), written and checked by flexcontact.saved_factor.
+
+Loading rebuilds the dam's mesh and assembles its matrices (no factorization), checks that
+the mesh numbers its DOFs as the saved one did, and restores the factors. Only a changed
+input or format invalidates a model, not a new flexcontact version; a model from another
+MUMPS must be prepared again (its factor files are tied to its version).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from .. import saved_factor
+from ..errors import InputError, SavedFileError
+
+MODEL_FORMAT = 1
+"""The model directory's format: a model of another format is refused."""
+
+
+def inputs_of(base, dt_s: float, water_levels_m, strip_m) -> dict:
+    """What the model depends on, as plain JSON values."""
+    return {"base": base.as_dict(), "dt_s": float(dt_s),
+            "water_levels_m": [float(z) for z in water_levels_m],
+            "strip_m": [float(z) for z in strip_m]}
+
+
+def inputs_hash(inputs: dict) -> str:
+    return hashlib.sha256(json.dumps(inputs, sort_keys=True).encode()).hexdigest()
+
+
+def prepare(base, dt_s: float, water_levels_m, path, levels=None,
+            lags: int | None = None, progress=print) -> dict:
+    """Build and factor the dam of ``base`` at ``dt_s`` for the water levels
+    ``water_levels_m`` = (lowest, highest), and write its model to the directory ``path``
+    (replaced atomically if it exists). ``levels``: the water levels whose static state is
+    stored (default: both ends of the range); ``lags``: response-function lags tabulated
+    now (default: twice the steps of the base scenario's run; a longer run extends them on
+    load, from the saved adjoint state, counted). Returns the manifest."""
+    from .dam_model import DamModel
+    path = Path(path)
+    t0 = time.perf_counter()
+    dam = DamModel(base, dt_s, water_levels_m, MPI.COMM_SELF)
+    progress(f"dam meshed, assembled and factored: {dam.V.dofmap.index_map.size_global * 2} "
+             f"DOFs, face strip {dam.strip_m[0]:.3f}..{dam.strip_m[1]:.3f} m "
+             f"({dam.face_dofs.size} face DOFs), {time.perf_counter() - t0:.1f} s")
+    levels = sorted({float(z) for z in (levels or dam.water_levels_m)})
+    statics = {z: dam.static_state(z) for z in levels}
+    compliance = dam.face_compliance(0)
+    responses = dam.responses()
+    if lags is None:
+        from .coupled_step import run_steps
+        lags = 2 * run_steps(base, dam)
+    responses.ensure(int(lags))
+    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    tmp.mkdir(parents=True)
+    try:
+        factors = {}
+        for name, matrix in (("stage1", dam._K1), ("stage2", dam.W_hat)):
+            f = saved_factor.factor_matrix(matrix)
+            dam.factorizations[f"dam_{name}"] += 1
+            factors[name] = saved_factor.save_factor(f, tmp, name)
+            f.destroy()
+        arrays = {"W_face": dam.W_face, "face_dofs": dam.face_dofs,
+                  "face_compliance_x": compliance}
+        arrays.update(responses.saved())
+        for i, (z, st) in enumerate(statics.items()):
+            arrays[f"static_u_{i}"] = st.u.x.array
+        np.savez(tmp / "arrays.npz", **arrays)
+        inputs = inputs_of(base, dt_s, dam.water_levels_m, dam.strip_m)
+        from .. import __version__
+        manifest = {
+            "format": MODEL_FORMAT, "flexcontact_version": __version__,
+            "inputs": inputs, "inputs_sha256": inputs_hash(inputs),
+            "mesh_sha256": dam.mesh_hash(), "levels_m": levels,
+            "statics": {str(i): {"water_level_m": z,
+                                 "section": statics[z].section.__dict__,
+                                 "section_foundation": statics[z].section_foundation.__dict__}
+                        for i, z in enumerate(levels)},
+            "factors": factors, "counts": dam.counts(),
+            "files": {"arrays.npz": _file_entry(tmp / "arrays.npz")}}
+        (tmp / "manifest.json").write_text(json.dumps(manifest, indent=1, default=_plain))
+        old = path.parent / f".{path.name}.old-{os.getpid()}"
+        if path.exists():
+            path.rename(old)
+        tmp.rename(path)
+        if old.exists():
+            shutil.rmtree(old)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    progress(f"model written to {path} in {time.perf_counter() - t0:.1f} s")
+    return manifest
+
+
+def _plain(x):
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, tuple):
+        return list(x)
+    raise TypeError(f"{type(x)} is not JSON")
+
+
+def _file_entry(p: Path) -> dict:
+    return {"bytes": p.stat().st_size, "sha256": saved_factor.sha256(p)}
+
+
+def read_manifest(path) -> dict:
+    """The checked manifest of the model at ``path``: SavedFileError naming what is missing,
+    truncated, altered or of another format."""
+    path = Path(path)
+    mpath = path / "manifest.json"
+    if not mpath.is_file():
+        raise SavedFileError(f"{path}: not a dam model (no manifest.json); write one with "
+                             "`python3 -m flexcontact dam prepare CONFIG.toml`")
+    try:
+        manifest = json.loads(mpath.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise SavedFileError(f"{mpath}: not readable JSON ({e}): a truncated or altered "
+                             "model") from None
+    if manifest.get("format") != MODEL_FORMAT:
+        raise SavedFileError(f"{path}: model format {manifest.get('format')!r}; this "
+                             f"flexcontact reads format {MODEL_FORMAT}: prepare it again")
+    if inputs_hash(manifest["inputs"]) != manifest.get("inputs_sha256"):
+        raise SavedFileError(f"{mpath}: its inputs do not match their SHA-256 (the manifest "
+                             "was edited)")
+    for name, want in manifest["files"].items():
+        p = path / name
+        if not p.is_file():
+            raise SavedFileError(f"{p}: missing from the model")
+        got = _file_entry(p)
+        if got["bytes"] != want["bytes"]:
+            raise SavedFileError(f"{p}: {got['bytes']} bytes, {want['bytes']} were saved (a "
+                                 "truncated or replaced file)")
+        if got["sha256"] != want["sha256"]:
+            raise SavedFileError(f"{p}: its SHA-256 differs from the saved one (the file was "
+                                 "altered)")
+    for entry in manifest["factors"].values():
+        saved_factor.check_factor_files(path, entry)
+    return manifest
+
+
+def check_inputs(manifest: dict, base=None, dt_s=None) -> None:
+    """SavedFileError naming the first input of ``base`` / ``dt_s`` that differs from the
+    model's (only the dam's parameters matter: see reuse.DAM_PARAMETERS)."""
+    from .reuse import DAM_PARAMETERS
+    saved = manifest["inputs"]
+    if base is not None:
+        now = base.as_dict()
+        for name in DAM_PARAMETERS:
+            if json.loads(json.dumps(now[name], default=_plain)) != saved["base"][name]:
+                raise SavedFileError(f"{name}={now[name]!r} differs from the model's "
+                                     f"{saved['base'][name]!r}: prepare a model for it")
+    if dt_s is not None and float(dt_s) != saved["dt_s"]:
+        raise SavedFileError(f"dt_s={dt_s!r} differs from the model's {saved['dt_s']!r}")
+
+
+def load(path, comm=MPI.COMM_SELF, **evaluator_options):
+    """The ScenarioEvaluator of the model at ``path``: the dam rebuilt (mesh and assembly,
+    no factorization), its factors and operators restored. Raises SavedFileError if a file
+    or the rebuilt mesh does not match."""
+    from .dam_model import DamModel, StaticState
+    from .reuse import ScenarioEvaluator
+    from .scenario import DamScenario
+    from .section import BaseSection
+    path = Path(path)
+    manifest = read_manifest(path)
+    inputs = manifest["inputs"]
+    base = DamScenario.from_dict(inputs["base"])
+    restored = {name: saved_factor.restore_factor(path, entry)
+                for name, entry in manifest["factors"].items()}
+    with np.load(path / "arrays.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    restored["W_face"] = arrays["W_face"]
+    dam = DamModel(base, inputs["dt_s"], tuple(inputs["water_levels_m"]), comm,
+                   strip_m=tuple(inputs["strip_m"]), restored=restored)
+    if dam.mesh_hash() != manifest["mesh_sha256"] or not np.array_equal(
+            dam.face_dofs, arrays["face_dofs"]):
+        import dolfinx
+        import gmsh
+        raise SavedFileError(
+            f"{path}: the dam's mesh rebuilt here (DOLFINx {dolfinx.__version__}, gmsh "
+            f"{gmsh.__version__}) numbers its nodes differently from the saved one: prepare "
+            "the model again on this installation")
+    dam._compliance_0 = arrays["face_compliance_x"]
+    dam.responses().restore(arrays)
+    for i, st in manifest["statics"].items():
+        import dolfinx.fem
+        u = dolfinx.fem.Function(dam.V, name="displacement_m")
+        u.x.array[:] = arrays[f"static_u_{i}"]
+        dam._statics[float(st["water_level_m"])] = StaticState(
+            float(st["water_level_m"]), u, BaseSection(**_section(st["section"])),
+            BaseSection(**_section(st["section_foundation"])))
+    return ScenarioEvaluator(base, comm=comm, dam=dam, **evaluator_options)
+
+
+def _section(d: dict) -> dict:
+    return {**d, "force_N": tuple(d["force_N"])}
