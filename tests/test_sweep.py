@@ -418,10 +418,11 @@ def test_monolithic_sweep_over_speeds_scales_and_counts(tmp_path):
 
 
 def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
-    """The issue's count: over speeds, pitch angles, friction and water levels on one dam
-    mesh and one log geometry, the reusing evaluator factors K (stage 1) and K_eff
-    (stage 2) once each, plus the log's own factorization: three in all, whatever the
-    number of scenarios (serial: one evaluator)."""
+    """Over speeds, pitch angles, friction and water levels on one dam mesh and one log
+    geometry: the dam model is prepared once (K and K_eff factored for the dam and again
+    for the saved factors: two each), the evaluator restores both factors and factors
+    nothing of the dam, and the log is factored once — whatever the number of scenarios
+    (serial: one evaluator)."""
     pytest.importorskip("flexcontact.dam.reuse")
     raw = {"parameters": {"log_speed_m_s": {"values": [1.5, 3.0]},
                           "log_pitch_deg": {"values": [5.0, 10.0]},
@@ -430,7 +431,20 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
            "engine": {"evaluator": "reuse", "kind": "serial"}, "output": {"plots": False}}
     s = sweep.run(sweep.from_dict(raw), out=tmp_path / "out")
     assert s["scenarios"] == 16
-    assert s["counts"]["factorizations"]["total"] == 3, s["counts"]
+    assert s["counts"]["factorizations"]["total"] == 1, s["counts"]      # the log
+    assert s["counts"]["restorations"]["total"] == 2, s["counts"]       # K and K_eff
+    assert s["dam_model"]["prepared_this_run"]
+    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 2, "dam_stage2": 2}
+    # Run again with the model given: reused, not prepared, the same table.
+    raw["engine"]["model"] = s["dam_model"]["path"]
+    again = sweep.run(sweep.from_dict(raw), out=tmp_path / "again")
+    assert not again["dam_model"]["prepared_this_run"]
+    assert again["worst"] == s["worst"]
+    # A model of another dam is refused, naming the parameter, before any computing.
+    raw["base"] = {"crest_width_m": 6.0}
+    with pytest.raises(ConfigError, match="crest_width_m=6.0"):
+        sweep.run(sweep.from_dict(raw), out=tmp_path / "other")
+    assert not (tmp_path / "other" / "results.jsonl").exists()
 
 
 # ---- a categorical input: the log's end shape ---------------------------------------------

@@ -17,6 +17,9 @@ def add_parser(sub) -> None:
     p.add_argument("--engine", choices=ENGINES, help="overrides engine.kind")
     p.add_argument("--workers", type=int, help="overrides engine.workers")
     p.add_argument("--scheduler", help="Dask scheduler address (engine dask)")
+    p.add_argument("--model", help="a dam model directory (flexcontact dam prepare) the "
+                                   "workers load; default: <out>/dam_model, prepared once "
+                                   "(engine.model)")
     p.add_argument("--check-convergence", action="store_true",
                    help="rerun each output's most unfavourable scenario at refine + 1")
 
@@ -40,6 +43,8 @@ def main(args) -> int:
         for key in ("workers", "scheduler"):
             if getattr(args, key) is not None:
                 cfg.engine[key] = getattr(args, key)
+        if getattr(args, "model", None):
+            cfg.engine["model"] = args.model
         if args.engine:
             cfg.engine["kind"] = args.engine
         elif args.scheduler:

@@ -50,7 +50,7 @@ ENGINES = ("serial", "processes", "mpi", "dask")
 EVALUATORS = ("reuse", "monolithic")
 _TABLES = {"base", "sample", "parameters", "engine", "output"}
 _SAMPLE = {"method", "n", "seed"}
-_ENGINE = {"evaluator", "kind", "workers", "scheduler", "start_method"}
+_ENGINE = {"evaluator", "kind", "workers", "scheduler", "start_method", "model"}
 _OUTPUT = {"dir", "plots", "bootstrap", "band"}
 
 
@@ -159,7 +159,7 @@ def _engine(table: dict) -> dict:
     _unknown("engine", table, _ENGINE)
     e = {"evaluator": table.get("evaluator", "reuse"), "kind": table.get("kind", "processes"),
          "workers": table.get("workers"), "scheduler": table.get("scheduler"),
-         "start_method": table.get("start_method", "spawn")}
+         "start_method": table.get("start_method", "spawn"), "model": table.get("model")}
     ev = e["evaluator"]
     if not isinstance(ev, str) or not (ev in EVALUATORS or ":" in ev):
         raise ConfigError(f"engine.evaluator={ev!r}: must be one of {list(EVALUATORS)} or "
@@ -176,6 +176,9 @@ def check_engine(e: dict) -> None:
         _int("engine.workers", e["workers"], 1)
     if e["scheduler"] is not None and not isinstance(e["scheduler"], str):
         raise ConfigError(f"engine.scheduler={e['scheduler']!r}: must be an address string")
+    if e.get("model") is not None and not (isinstance(e["model"], str) and e["model"]):
+        raise ConfigError(f"engine.model={e['model']!r}: must be the path of a dam model "
+                          "directory")
     if e["start_method"] not in ("spawn", "forkserver"):
         raise ConfigError(f"engine.start_method={e['start_method']!r}: must be 'spawn' or "
                           f"'forkserver'")

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Optional, TextIO, Union
 
@@ -15,9 +16,11 @@ from .scenarios import build_scenarios, point_hash
 from .table import ResultTable
 
 
-def prepare(cfg: SweepConfig) -> dict:
+def prepare(cfg: SweepConfig, folder: Optional[Path] = None) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
-    import), the sweep's time step and water levels."""
+    import), the sweep's time step and water levels, and for the "reuse" evaluator in 2D
+    the dam model every worker loads (engine.model, else ``folder``/dam_model, prepared here
+    once if it is not there yet)."""
     base, points, scenarios = build_scenarios(cfg)
     cls, _ = evaluators.resolve(cfg.engine["evaluator"])
     dt = evaluators.sweep_time_step(cfg.engine["evaluator"], scenarios)
@@ -25,9 +28,39 @@ def prepare(cfg: SweepConfig) -> dict:
     spec = EvaluatorSpec(cfg.engine["evaluator"], base, dt, (min(levels), max(levels)))
     prep = {"base": base, "points": points, "scenarios": scenarios, "spec": spec, "dt_s": dt,
             "checker": None}
+    model = cfg.engine.get("model") or (folder / "dam_model" if folder is not None else None)
+    if cfg.engine["evaluator"] == "reuse" and base.dim == 2 and model is not None:
+        prep["model"] = dam_model(Path(model), base, dt, levels)
+        spec = prep["spec"] = replace(spec, model=str(model))
     if hasattr(cls, "check"):
         prep["checker"] = check_all(spec, points, scenarios)
     return prep
+
+
+def dam_model(path: Path, base, dt: float, levels: list) -> dict:
+    """The dam model at ``path`` for this sweep: prepared there once (atomically) if absent,
+    else checked against the sweep's dam and time step (ConfigError naming what differs).
+    Returns {"path", "prepared_this_run", "counts"}: the factorizations its preparation
+    cost."""
+    from ..dam import model_file
+    from ..errors import SavedFileError
+    prepared = not (path / "manifest.json").is_file()
+    try:
+        if prepared:
+            distinct = sorted(set(levels))
+            manifest = model_file.prepare(base, dt, (min(levels), max(levels)), path,
+                                          levels=distinct if len(distinct) <= 8 else None,
+                                          progress=lambda *a: None)
+        else:
+            manifest = model_file.read_manifest(path)
+            model_file.check_inputs(manifest, base, dt)
+    except SavedFileError as e:
+        raise ConfigError(f"engine.model={str(path)!r}: {e}") from None
+    lo, hi = manifest["inputs"]["water_levels_m"]
+    if not (lo <= min(levels) and max(levels) <= hi):
+        raise ConfigError(f"engine.model={str(path)!r}: its water levels {lo}..{hi} m do not "
+                          f"cover the sweep's {min(levels)}..{max(levels)} m")
+    return {"path": str(path), "prepared_this_run": prepared, "counts": manifest["counts"]}
 
 
 def check_all(spec: EvaluatorSpec, points: list, scenarios: list):
@@ -54,10 +87,10 @@ def run(cfg: SweepConfig, out: Optional[Union[str, Path]] = None,
     the summary also written to ``summary.json``."""
     check_engine(cfg.engine)
     t0 = time.perf_counter()
-    prep = prepare(cfg)
+    folder = Path(out or cfg.output["dir"])
+    prep = prepare(cfg, folder)
     prep["timings_s"] = {"prepare": time.perf_counter() - t0}
     points, scenarios = prep["points"], prep["scenarios"]
-    folder = Path(out or cfg.output["dir"])
     table = ResultTable(folder, cfg.hash(), [point_hash(p) for p in points])
     done = table.open()
     tasks = [(i, s) for i, s in enumerate(scenarios) if i not in done]
@@ -106,6 +139,8 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
                                               if rows else math.nan),
                 "base": prep["base"].as_dict(),
                 "evaluator_timings_s": _sum_timings(rows)}
+    if "model" in prep:
+        run_info["dam_model"] = prep["model"]
     summary = sweep_report.summarize(run_info, rows, inputs, outputs, cfg)
     if prep["checker"] is not None and e["kind"] != "serial":
         # The evaluator that checked the scenarios in this process computed none of them.

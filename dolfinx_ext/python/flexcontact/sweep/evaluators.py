@@ -24,7 +24,8 @@ import importlib
 import os
 import socket
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Optional
 
 from .errors import ConfigError
 
@@ -69,9 +70,17 @@ class EvaluatorSpec:
     base: object
     dt_s: float
     water_levels_m: tuple
+    model: Optional[str] = None
+    """A dam model directory (dam/model_file.py) every worker loads instead of factoring
+    the dam (the "reuse" evaluator only)."""
 
     def build(self):
         from mpi4py import MPI
+        if self.model is not None:
+            from ..dam import model_file
+            model_file.check_inputs(model_file.read_manifest(self.model), self.base,
+                                    self.dt_s)
+            return model_file.load(self.model, MPI.COMM_SELF)
         cls, _ = resolve(self.name)
         return cls(self.base, dt_s=self.dt_s, water_levels_m=list(self.water_levels_m),
                    comm=MPI.COMM_SELF)
@@ -98,7 +107,8 @@ def _zero() -> dict:
 def _delta(now: dict, before: dict) -> dict:
     return {kind: {k: int(v) - int(before.get(kind, {}).get(k, 0))
                    for k, v in now.get(kind, {}).items()}
-            for kind in ("factorizations", "back_substitutions")}
+            for kind in ("factorizations", "back_substitutions", "restorations")
+            if kind in now or kind != "restorations"}
 
 
 def evaluate_task(spec: EvaluatorSpec, task: tuple) -> dict:

@@ -235,13 +235,23 @@ def _computation(s: dict) -> list:
          + f"; {s['wall_s']:.1f} s this run ({s['computed_this_run']} scenarios computed, "
          f"{s['scenarios'] - s['computed_this_run']} from an earlier run).", ""]
     c = s["counts"]
-    keys = sorted((set(c["factorizations"]) | set(c["back_substitutions"])) - {"total"})
+    keys = sorted((set(c["factorizations"]) | set(c["back_substitutions"])
+                   | set(c.get("restorations", {}))) - {"total"})
     keys.append("total")
     L += ["Factorizations and back-substitutions, summed over workers and runs:", "",
           "| | " + " | ".join(keys) + " |", "|---|" + "---|" * len(keys)]
-    for kind in ("factorizations", "back_substitutions"):
-        L.append(f"| {kind.replace('_', '-')} | "
-                 + " | ".join(str(c[kind].get(k, 0)) for k in keys) + " |")
+    for kind in ("factorizations", "restorations", "back_substitutions"):
+        if kind in c:
+            L.append(f"| {kind.replace('_', '-')} | "
+                     + " | ".join(str(c[kind].get(k, 0)) for k in keys) + " |")
+    if "dam_model" in s:
+        m = s["dam_model"]
+        f = m["counts"]["factorizations"]
+        L += ["", (f"The dam model `{m['path']}` was prepared by this run (factorizations of "
+                   f"the dam, once: {f}; not in the sums above) and every worker loaded it: "
+                   if m["prepared_this_run"] else
+                   f"Every worker loaded the dam model `{m['path']}`, prepared before: ")
+              + "the dam's factors are restored, not factored (row `restorations`)."]
     if "counts_driver_check" in s:
         d = s["counts_driver_check"]
         L += ["", "Not in these sums: the evaluator the driving process built to check every "
