@@ -5,6 +5,7 @@
 #include "contact_blocks.h"
 #include "ordering.h"
 #include "flexibility.h"
+#include "mumps_instance.h"
 #include "petsc_error.h"
 
 #include <algorithm>
@@ -20,37 +21,6 @@ namespace
 int& icntl(DMUMPS_STRUC_C& id, int i) { return id.icntl[i - 1]; }
 int infog(const DMUMPS_STRUC_C& id, int i) { return id.infog[i - 1]; }
 
-/// @brief The upper triangle (col ≥ row) of K's local rows as 1-based triplets.
-void local_upper_triplets(Mat K, std::vector<int>& irn, std::vector<int>& jcn,
-                          std::vector<double>& a)
-{
-  PetscErrorScope err;
-  PetscInt rstart = 0, rend = 0;
-  err.check(MatGetOwnershipRange(K, &rstart, &rend), "MatGetOwnershipRange");
-  MatInfo info;
-  err.check(MatGetInfo(K, MAT_LOCAL, &info), "MatGetInfo");
-  const auto guess = static_cast<std::size_t>(info.nz_used / 2 + (rend - rstart));
-  irn.clear(), jcn.clear(), a.clear();
-  irn.reserve(guess), jcn.reserve(guess), a.reserve(guess);
-  // An SBAIJ K gives its stored upper triangle; an AIJ K its full rows, halved here.
-  err.check(MatGetRowUpperTriangular(K), "MatGetRowUpperTriangular");
-  for (PetscInt r = rstart; r < rend; ++r)
-  {
-    PetscInt ncols = 0;
-    const PetscInt* cols = nullptr;
-    const PetscScalar* vals = nullptr;
-    err.check(MatGetRow(K, r, &ncols, &cols, &vals), "MatGetRow");
-    for (PetscInt k = 0; k < ncols; ++k)
-      if (cols[k] >= r)
-      {
-        irn.push_back(static_cast<int>(r + 1));
-        jcn.push_back(static_cast<int>(cols[k] + 1));
-        a.push_back(vals[k]);
-      }
-    err.check(MatRestoreRow(K, r, &ncols, &cols, &vals), "MatRestoreRow");
-  }
-  err.check(MatRestoreRowUpperTriangular(K), "MatRestoreRowUpperTriangular");
-}
 } // namespace
 
 DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, int icntl7,
@@ -65,7 +35,7 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
                                 "32-bit indices hold");
   n_c_ = static_cast<int>(schur.size());
   schur_rows_ = schur;
-  local_upper_triplets(K, irn_, jcn_, a_);
+  upper_triplets(K, irn_, jcn_, a_);
   err.check(MatGetOwnershipRange(K, &rstart_, &rend_), "MatGetOwnershipRange");
   irhs_loc_.assign(std::max<std::size_t>(rend_ - rstart_, 1), 1); // never a null IRHS_loc
   for (PetscInt r = rstart_; r < rend_; ++r)
@@ -135,23 +105,8 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
 void DistributedSchur::factorize()
 {
   double t0 = MPI_Wtime();
-  // As in serial (flexibility.cpp): LDLᵀ with pivoting can outgrow the workspace the
-  // analysis estimated; MUMPS's remedy is a larger ICNTL(14), the analysis stays valid.
-  for (;;)
-  {
-    id_.job = 2;
-    dmumps_c(&id_);
-    const int e = infog(id_, 1);
-    if ((e == -8 or e == -9) and stats_.retries < 5)
-    {
-      icntl(id_, 14) = std::max(2 * icntl(id_, 14), 50);
-      ++stats_.retries;
-      continue;
-    }
-    if (e < 0)
-      throw_mumps_error("factorization", e, infog(id_, 2));
-    break;
-  }
+  // As in serial (flexibility.cpp): the workspace may need to grow.
+  stats_.retries = factorize_growing_workspace(id_);
   stats_.factorization_s = MPI_Wtime() - t0;
   stats_.null_pivots = infog(id_, 28);
   throw_if_null_pivots(stats_.null_pivots);
@@ -181,14 +136,9 @@ DistributedSchur::~DistributedSchur() { release(); }
 
 void DistributedSchur::release()
 {
+  end_instance(id_, alive_);
   int finalized = 0;
   MPI_Finalized(&finalized);
-  if (alive_ and !finalized)
-  {
-    id_.job = -2;
-    dmumps_c(&id_);
-  }
-  alive_ = false;
   if (!finalized and !PetscFinalizeCalled)
   {
     VecScatterDestroy(&to_zero_);

@@ -3,6 +3,7 @@
 #include "saved_factor.h"
 #include "collective.h"
 #include "flexibility.h"
+#include "mumps_instance.h"
 #include "petsc_error.h"
 
 #include <mpi.h>
@@ -53,23 +54,7 @@ SavedFactor::SavedFactor(Mat A)
     throw std::invalid_argument("SavedFactor: a square matrix of 1 to 2^31 - 2 rows is needed, "
                                 "not " + std::to_string(rows) + " x " + std::to_string(cols));
   n_ = rows;
-  err.check(MatGetRowUpperTriangular(A), "MatGetRowUpperTriangular");
-  for (PetscInt r = 0; r < n_; ++r)
-  {
-    PetscInt nc = 0;
-    const PetscInt* c = nullptr;
-    const PetscScalar* v = nullptr;
-    err.check(MatGetRow(A, r, &nc, &c, &v), "MatGetRow");
-    for (PetscInt k = 0; k < nc; ++k)
-      if (c[k] >= r)
-      {
-        irn_.push_back(static_cast<int>(r + 1));
-        jcn_.push_back(static_cast<int>(c[k] + 1));
-        a_.push_back(v[k]);
-      }
-    err.check(MatRestoreRow(A, r, &nc, &c, &v), "MatRestoreRow");
-  }
-  err.check(MatRestoreRowUpperTriangular(A), "MatRestoreRowUpperTriangular");
+  upper_triplets(A, irn_, jcn_, a_);
   init();
   try
   {
@@ -81,20 +66,7 @@ SavedFactor::SavedFactor(Mat A)
     id_.jcn = jcn_.data();
     id_.a = a_.data();
     call(1, "analysis");
-    for (int retries = 0;; ++retries)
-    {
-      id_.job = 2;
-      dmumps_c(&id_);
-      const int e = infog(id_, 1);
-      if ((e == -8 or e == -9) and retries < 5)
-      {
-        icntl(id_, 14) = std::max(2 * icntl(id_, 14), 50); // pivoting outgrew the estimate
-        continue;
-      }
-      if (e < 0)
-        throw_mumps_error("factorization", e, infog(id_, 2));
-      break;
-    }
+    factorize_growing_workspace(id_);
     throw_if_null_pivots(infog(id_, 28));
   }
   catch (...)
@@ -136,14 +108,7 @@ SavedFactor::~SavedFactor() { release(); }
 
 void SavedFactor::release()
 {
-  int finalized = 0;
-  MPI_Finalized(&finalized);
-  if (alive_ and !finalized)
-  {
-    id_.job = -2;
-    dmumps_c(&id_);
-  }
-  alive_ = false;
+  end_instance(id_, alive_);
 }
 
 void SavedFactor::set_files(const std::string& dir, const std::string& prefix)
