@@ -20,7 +20,7 @@ from flexcontact.errors import FlexcontactError, SavedFileError
 def matrix(n=40):
     """A symmetric indefinite matrix: a shifted 2D Laplacian on an n × n grid with its first
     row and column replaced by a held DOF (a 1 on the diagonal), as a PETSc AIJ."""
-    T = sp.diags([-1, 2, -1], [-1, 0, 1], shape=(n, n))
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
     A = (sp.kron(T, sp.eye(n)) + sp.kron(sp.eye(n), T) - 0.3 * sp.eye(n * n)).tolil()
     A[0, :] = 0
     A[:, 0] = 0

@@ -419,24 +419,31 @@ def test_monolithic_sweep_over_speeds_scales_and_counts(tmp_path):
 
 def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     """Over speeds, pitch angles, friction and water levels on one dam mesh and one log
-    geometry: the dam model is prepared once (K and K_eff factored for the dam and again
-    for the saved factors: two each), the evaluator restores both factors and factors
-    nothing of the dam, and the log is factored once — whatever the number of scenarios
-    (serial: one evaluator)."""
+    geometry, the reusing evaluator factors K (stage 1) and K_eff (stage 2) once each, plus
+    the log's own factorization: three in all, whatever the number of scenarios (serial:
+    one evaluator). With a dam model (engine.model) it is prepared once (K and K_eff
+    factored for the dam and again for the saved factors: two each), the evaluator restores
+    both factors and factors nothing of the dam, and the table is the same to 1e-10."""
     pytest.importorskip("flexcontact.dam.reuse")
     raw = {"parameters": {"log_speed_m_s": {"values": [1.5, 3.0]},
                           "log_pitch_deg": {"values": [5.0, 10.0]},
                           "friction_mu": {"values": [0.3, 0.6]},
                           "water_level_m": {"values": [26.0, 27.0]}},
            "engine": {"evaluator": "reuse", "kind": "serial"}, "output": {"plots": False}}
+    own = sweep.run(sweep.from_dict(raw), out=tmp_path / "own")
+    assert own["scenarios"] == 16
+    assert own["counts"]["factorizations"]["total"] == 3, own["counts"]
+    assert "dam_model" not in own
+    raw["engine"]["model"] = str(tmp_path / "model")
     s = sweep.run(sweep.from_dict(raw), out=tmp_path / "out")
-    assert s["scenarios"] == 16
     assert s["counts"]["factorizations"]["total"] == 1, s["counts"]      # the log
     assert s["counts"]["restorations"]["total"] == 2, s["counts"]       # K and K_eff
     assert s["dam_model"]["prepared_this_run"]
     assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 2, "dam_stage2": 2}
-    # Run again with the model given: reused, not prepared, the same table.
-    raw["engine"]["model"] = s["dam_model"]["path"]
+    for o, w in own["worst"].items():
+        assert s["worst"][o]["id"] == w["id"]
+        assert s["worst"][o]["value"] == pytest.approx(w["value"], rel=1e-10)
+    # Run again with the model there: reused, not prepared, the same table.
     again = sweep.run(sweep.from_dict(raw), out=tmp_path / "again")
     assert not again["dam_model"]["prepared_this_run"]
     assert again["worst"] == s["worst"]

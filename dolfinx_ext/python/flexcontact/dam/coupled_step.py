@@ -18,7 +18,9 @@ condensed bodies (stepper.BodiesStepper):
 from __future__ import annotations
 
 import math
+import time
 from types import SimpleNamespace
+from typing import Optional
 
 import numpy as np
 
@@ -95,7 +97,8 @@ to the end)."""
 
 
 def run_impact(dam, log, s, static, offset_m: float = 1.0,
-               after_contact: str = "convolve", histories: bool = False) -> dict:
+               after_contact: str = "convolve", histories: bool = False,
+               timings: Optional[dict] = None) -> dict:
     """The impact of scenario ``s`` (a DamScenario) from the static state ``static`` of
     ``dam`` at its water level, with ``log`` (the LogModel of its log). Returns the outputs
     (plain floats, see ScenarioEvaluator.evaluate); with ``histories``, also
@@ -105,7 +108,11 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     cannot bring the face back to it (:func:`_cannot_touch`), the dam is no longer stepped:
     only the log is, and the base section's history comes from the convolution of the face
     impulses with its response functions. Should the log come back within that bound, the
-    dam is stepped again from where it stopped (its back-substitutions counted)."""
+    dam is stepped again from where it stopped (its back-substitutions counted).
+
+    ``timings``: a dict to which the seconds of the steps with the dam stepped
+    ("coupled_steps_s"), of those with the log alone ("log_only_steps_s") and of the
+    convolution ("convolution_s") are added."""
     if after_contact not in AFTER_CONTACT:
         raise ValueError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
     h, theta, d = dam.dt, dam.theta, 2
@@ -141,7 +148,9 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     dam_slice = slice(n_log, n_log + dam.face_dofs.size)   # the kernel's DOFs: log, then dam
     face_x = pairs.x[m:, 0] + u_face0[0::d]   # the face nodes' static x (m)
     stopped, touched, last_contact = None, False, -1
+    clock = {"coupled_steps_s": 0.0, "log_only_steps_s": 0.0, "convolution_s": 0.0}
     for i in range(n):
+        t_step = time.perf_counter()
         t = i * h
         u_log = _log_values(log, bl.w, R, V0 * t)
         if stopped is not None:
@@ -149,6 +158,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
                              stopped["bound"], h):
                 bl.advance(_free_log_step(log, bl), h, theta)
                 records.append(SimpleNamespace(t_s=(i + 1) * h, active=0, normal_force=0.0))
+                clock["log_only_steps_s"] += time.perf_counter() - t_step
                 continue
             _replay(dam, bd, stopped["step"], i, h, theta, section)  # back to stepping
             stopped = None
@@ -178,12 +188,18 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
             bound = np.sqrt(2.0 * max(dam.energy_J(bd.w, bd.omega), 0.0)
                             * dam.face_compliance(0))
             stopped = {"step": i + 1, "bound": bound}
+        clock["coupled_steps_s"] += time.perf_counter() - t_step
+    t_conv = time.perf_counter()
     if stopped is not None:
         # The base section after the last stepped step, from the whole impulse history.
         k0 = stopped["step"]
         conv = dam.responses().convolve(impulses[:last_contact + 1], n)
         for q in section:
             section[q][k0:] = conv[q][k0:]
+    clock["convolution_s"] += time.perf_counter() - t_conv
+    if timings is not None:
+        for k, v in clock.items():
+            timings[k] = timings.get(k, 0.0) + v
     heel_static = static.section.sigma_heel_Pa
     heel = heel_static + float(section["sigma_heel_Pa"].max()) if touched else -math.inf
     out = _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,

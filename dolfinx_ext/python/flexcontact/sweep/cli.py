@@ -17,9 +17,9 @@ def add_parser(sub) -> None:
     p.add_argument("--engine", choices=ENGINES, help="overrides engine.kind")
     p.add_argument("--workers", type=int, help="overrides engine.workers")
     p.add_argument("--scheduler", help="Dask scheduler address (engine dask)")
-    p.add_argument("--model", help="a dam model directory (flexcontact dam prepare) the "
-                                   "workers load; default: <out>/dam_model, prepared once "
-                                   "(engine.model)")
+    p.add_argument("--model", help="a dam model directory (flexcontact dam prepare) every "
+                                   "worker loads instead of factoring the dam; prepared "
+                                   "there once if absent (engine.model)")
     p.add_argument("--check-convergence", action="store_true",
                    help="rerun each output's most unfavourable scenario at refine + 1")
 
