@@ -24,6 +24,8 @@ if VERSION not in SUPPORTED:
     raise ImportError(
         f"flexcontact supports DOLFINx 0.5, 0.9 and 0.11; this Python sees DOLFINx "
         f"{dolfinx.__version__} ({dolfinx.__file__})")
+STACK = f"DOLFINx {dolfinx.__version__}"
+"""The DOLFINx in use, for messages that name the installation."""
 NEW_API = VERSION >= (0, 8)
 GMSH_MODULE = VERSION >= (0, 10)   # dolfinx.io.gmshio became dolfinx.io.gmsh
 PETSC_LA = VERSION >= (0, 10)      # dolfinx.la's PETSc helpers moved to dolfinx.la.petsc

@@ -200,11 +200,12 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     if timings is not None:
         for k, v in clock.items():
             timings[k] = timings.get(k, 0.0) + v
-    heel_static = static.section.sigma_heel_Pa
-    heel = heel_static + float(section["sigma_heel_Pa"].max()) if touched else -math.inf
+    # The section is zero before the first impulse, so these extremes never pass the
+    # static values the wrong way.
+    heel = static.section.sigma_heel_Pa + float(section["sigma_heel_Pa"].max())
     out = _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,
                    offset_m, n)
-    out.update(_section_outputs(static, section, touched))
+    out.update(_section_outputs(static, section))
     out["dam_back_substitutions"] = dam.back_substitutions["dam_stage2"] - solves0[0]
     out["log_back_substitutions"] = log.back_substitutions - solves0[1]
     out["dam_steps_convolved"] = int(n - stopped["step"]) if stopped is not None else 0
@@ -214,12 +215,12 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     return out
 
 
-def _section_outputs(static, section: dict, touched: bool) -> dict:
+def _section_outputs(static, section: dict) -> dict:
     """The base section's extremes during the run: the most compressive toe stress and the
     largest changes of its normal force and moment (static values, no change, if the log
     never touched)."""
-    toe = static.section.sigma_toe_Pa + (float(section["sigma_toe_Pa"].min()) if touched else 0.0)
-    return {"toe_stress_impact_Pa": min(toe, static.section.sigma_toe_Pa),
+    return {"toe_stress_impact_Pa": (static.section.sigma_toe_Pa
+                                     + float(section["sigma_toe_Pa"].min())),
             "base_normal_force_change_N_per_m": float(np.abs(section["normal_force_N"]).max()),
             "base_moment_change_Nm_per_m": float(np.abs(section["moment_centre_Nm"]).max())}
 
@@ -281,7 +282,6 @@ def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_pea
     m = contact_metrics(records, h, filter_window_s=force_filter_window_s(s))
     dp = R @ log.momentum_local(bl.omega)  # the rigid part V₀ keeps its momentum
     static_heel = static.section.sigma_heel_Pa
-    heel = max(heel, static_heel)
     return {
         "peak_force_N_per_m": m["peak_force"],
         "peak_force_filtered_N_per_m": m["peak_force_filtered"],
@@ -296,7 +296,7 @@ def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_pea
                                         + dp[0] / log.mass_kg_per_m),
         "log_rotation_rad": log.rotation_rad(bl.w),
         "heel_stress_static_Pa": static_heel,
-        "heel_stress_impact_Pa": heel if math.isfinite(heel) else static_heel,
+        "heel_stress_impact_Pa": heel,
         "peak_tensile_stress_Pa": peak_principal if math.isfinite(peak_principal) else math.nan,
         "stress_offset_m": float(offset_m),
         "peak_contact_pressure_Pa": p_peak,

@@ -101,10 +101,12 @@ class DamModel:
         self.base, self.dt, self.theta, self.comm = base, float(dt_s), float(theta), comm
         self.water_levels_m = (lo, hi)
         self.strip_m = tuple(strip_m) if strip_m is not None else default_strip_m(base, (lo, hi))
-        # restored: {"stage1": factor of K, "stage2": factor of Ŵ, "W_face": array} read
-        # from a model file (dam/model_file.py): nothing is factored, the restorations are
-        # counted instead.
+        # restored: {"stage1": factor of K, "stage2": factor of Ŵ, "W_face": array,
+        # "face_compliance_x": array} read from a model file (dam/model_file.py): nothing is
+        # factored, the restorations are counted instead.
         self._restored = restored
+        self._compliance = ({0: restored["face_compliance_x"]}
+                            if restored is not None and "face_compliance_x" in restored else {})
         self.factorizations = {"dam_stage1": 0, "dam_stage2": 0}
         self.restorations = {"dam_stage1": 0, "dam_stage2": 0}
         self.back_substitutions = {"dam_stage1": 0, "dam_stage2": 0}
@@ -262,8 +264,7 @@ class DamModel:
         """(K⁻¹)_ii for the face DOFs i along ``axis`` (m/N, cached): with the dam's energy
         E (kinetic + strain), |w_i| ≤ sqrt(2 E (K⁻¹)_ii) as long as E does not grow. One
         back-substitution with K's factor per face node, counted in "dam_response"."""
-        key = f"_compliance_{axis}"
-        if not hasattr(self, key):
+        if axis not in self._compliance:
             d = self.base.dim
             dofs = self.face_dofs[axis::d]
             e, x = self.new_vector(), self.new_vector()
@@ -277,8 +278,8 @@ class DamModel:
                     self.back_substitutions.get("dam_response", 0) + 1)
             e.destroy()
             x.destroy()
-            setattr(self, key, out)
-        return getattr(self, key)
+            self._compliance[axis] = out
+        return self._compliance[axis]
 
     def energy_J(self, w: PETSc.Vec, omega: PETSc.Vec) -> float:
         """½ωᵀMω + ½wᵀKw of the motion (w, ω) about the static state (J; J/m in 2D)."""

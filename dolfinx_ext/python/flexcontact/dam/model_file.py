@@ -59,7 +59,8 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
     path = Path(path)
     t0 = time.perf_counter()
     dam = DamModel(base, dt_s, water_levels_m, MPI.COMM_SELF)
-    progress(f"dam meshed, assembled and factored: {dam.V.dofmap.index_map.size_global * 2} "
+    imap = dam.V.dofmap.index_map
+    progress(f"dam meshed, assembled and factored: {imap.size_global * dam.V.dofmap.index_map_bs} "
              f"DOFs, face strip {dam.strip_m[0]:.3f}..{dam.strip_m[1]:.3f} m "
              f"({dam.face_dofs.size} face DOFs), {time.perf_counter() - t0:.1f} s")
     levels = sorted({float(z) for z in (levels or dam.water_levels_m)})
@@ -192,17 +193,17 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
     with np.load(path / "arrays.npz") as z:
         arrays = {k: z[k] for k in z.files}
     restored["W_face"] = arrays["W_face"]
+    restored["face_compliance_x"] = arrays["face_compliance_x"]
     dam = DamModel(base, inputs["dt_s"], tuple(inputs["water_levels_m"]), comm,
                    strip_m=tuple(inputs["strip_m"]), restored=restored)
     if dam.mesh_hash() != manifest["mesh_sha256"] or not np.array_equal(
             dam.face_dofs, arrays["face_dofs"]):
-        import dolfinx
         import gmsh
+        from .. import compat
         raise SavedFileError(
-            f"{path}: the dam's mesh rebuilt here (DOLFINx {dolfinx.__version__}, gmsh "
-            f"{gmsh.__version__}) numbers its nodes differently from the saved one: prepare "
-            "the model again on this installation")
-    dam._compliance_0 = arrays["face_compliance_x"]
+            f"{path}: the dam's mesh rebuilt here ({compat.STACK}, gmsh {gmsh.__version__}) "
+            "numbers its nodes differently from the saved one: prepare the model again on "
+            "this installation")
     dam.responses().restore(arrays)
     for i, st in manifest["statics"].items():
         import dolfinx.fem

@@ -16,7 +16,7 @@ from .scenarios import build_scenarios, point_hash
 from .table import ResultTable
 
 
-def prepare(cfg: SweepConfig, folder: Optional[Path] = None) -> dict:
+def prepare(cfg: SweepConfig) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
     import), the sweep's time step and water levels, and, with engine.model for the "reuse"
     evaluator in 2D, the dam model every worker loads (prepared there once if it is not
@@ -89,7 +89,7 @@ def run(cfg: SweepConfig, out: Optional[Union[str, Path]] = None,
     check_engine(cfg.engine)
     t0 = time.perf_counter()
     folder = Path(out or cfg.output["dir"])
-    prep = prepare(cfg, folder)
+    prep = prepare(cfg)
     prep["timings_s"] = {"prepare": time.perf_counter() - t0}
     points, scenarios = prep["points"], prep["scenarios"]
     table = ResultTable(folder, cfg.hash(), [point_hash(p) for p in points])

@@ -24,7 +24,7 @@ import importlib
 import os
 import socket
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Optional
 
 from .errors import ConfigError

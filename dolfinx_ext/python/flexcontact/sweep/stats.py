@@ -143,7 +143,8 @@ def total_counts(rows: list) -> dict:
     for r in rows:
         for kind, d in r.get("counts", {}).items():
             for k, v in d.items():
-                tot.setdefault(kind, {})[k] = tot.setdefault(kind, {}).get(k, 0) + int(v)
+                d_kind = tot.setdefault(kind, {})
+                d_kind[k] = d_kind.get(k, 0) + int(v)
     for kind in list(tot):
         tot[kind]["total"] = sum(v for k, v in tot[kind].items() if k != "total")
     return tot
