@@ -216,15 +216,21 @@ def _model_3d(s, info):
 
 
 def _log_3d(s, occ):
-    """The log's solid: a cylinder, or its shaped profile revolved about the axis (OCC's
-    Boolean fuse of a cylinder and a spherical cap leaves a face it cannot mesh)."""
-    a, L, R, end = s.log_axis, s.log_length_m, s.log_radius_m, s.log_end
+    return log_solid(occ, s.log_centre, s.log_axis, s.log_length_m, s.log_radius_m, s.log_end)
+
+
+def log_solid(occ, centre, axis, length_m, radius_m, end):
+    """The 3D log's solid (axis ``axis``, centre ``centre``, front end at +L/2 along the
+    axis shaped by ``end``): a cylinder, or its shaped profile revolved about the axis
+    (OCC's Boolean fuse of a cylinder and a spherical cap leaves a face it cannot mesh)."""
+    a, L, R = np.asarray(axis, float), float(length_m), float(radius_m)
+    c = np.asarray(centre, float)
     if end.shape == "flat":
-        back = s.log_centre - 0.5 * L * a
+        back = c - 0.5 * L * a
         return occ.addCylinder(*map(float, back), *map(float, L * a), R)
     n = np.cross(a, [0.0, 1.0, 0.0] if abs(a[1]) < 0.9 else [1.0, 0.0, 0.0])
     n /= np.linalg.norm(n)
-    c, h, d = s.log_centre, 0.5 * L, end.depth_m(R)
+    h, d = 0.5 * L, end.depth_m(R)
 
     def point(x, y):
         return occ.addPoint(*map(float, c + x * a + y * n))
@@ -235,9 +241,9 @@ def _log_3d(s, occ):
         corner = point(h, R - float(end.chamfer_m))
         tip = [occ.addLine(rim_front, corner), occ.addLine(corner, axis_front)]
     else:
-        centre = point(end.cap(L, R)[0], 0.0)
-        tip = [occ.addCircleArc(rim_front, centre, axis_front)]
-        occ.remove([(0, centre)])
+        centre_pt = point(end.cap(L, R)[0], 0.0)
+        tip = [occ.addCircleArc(rim_front, centre_pt, axis_front)]
+        occ.remove([(0, centre_pt)])
     loop = [occ.addLine(axis_back, rim_back), occ.addLine(rim_back, rim_front), *tip,
             occ.addLine(axis_front, axis_back)]
     profile = occ.addPlaneSurface([occ.addCurveLoop(loop)])
@@ -250,7 +256,31 @@ def _log_3d(s, occ):
     return solids[0]
 
 
+def log_faces_3d(log_vol, centre, axis, length_m, radius_m, end) -> dict:
+    """The log's faces by tag (back, mantle, front), each by its centroid's axial position:
+    the back disc at -L/2, the shaft's mantle at -d/2, every face of the front end beyond
+    the shaft's end L/2 - d."""
+    import gmsh
+    log_faces = [abs(t) for _, t in gmsh.model.getBoundary([(3, log_vol)], oriented=False)]
+    L, d = float(length_m), end.depth_m(radius_m)
+    axial = {f: float((np.array(gmsh.model.occ.getCenterOfMass(2, f)) - centre) @ axis)
+             for f in log_faces}
+    out = {LOG_BACK: [min(log_faces, key=axial.get)],
+           LOG_FRONT: sorted(f for f in log_faces if axial[f] >= 0.5 * L - d - 1e-9 * L)}
+    out[LOG_MANTLE] = sorted(set(log_faces) - set(out[LOG_BACK]) - set(out[LOG_FRONT]))
+    return out
+
+
 def _faces_3d(s, dam, found, log_vol):
+    out = dam_faces_3d(s, dam, found)
+    out.update(log_faces_3d(log_vol, s.log_centre, s.log_axis, s.log_length_m,
+                            s.log_radius_m, s.log_end))
+    return out
+
+
+def dam_faces_3d(s, dam, found) -> dict:
+    """The dam's and the foundation's faces by tag (the downstream face: every dam face
+    not otherwise tagged)."""
     import gmsh
     B, W, H = s.base_width_m, s.dam_width_m, s.dam_height_m
     Lu, Ld, D = s.foundation_upstream_m, s.foundation_downstream_m, s.foundation_depth_m
@@ -272,22 +302,14 @@ def _faces_3d(s, dam, found, log_vol):
     dam_faces = {abs(t) for _, t in gmsh.model.getBoundary([(3, v) for v in dam],
                                                            oriented=False)}
     out[DAM_DOWNSTREAM] = sorted(dam_faces - taken)
-    log_faces = [abs(t) for _, t in gmsh.model.getBoundary([(3, log_vol)], oriented=False)]
-    # Each face by its centroid's axial position: the back disc at -L/2, the shaft's mantle
-    # at -d/2, every face of the front end beyond the shaft's end L/2 - d.
-    L, d = s.log_length_m, s.log_end.depth_m(s.log_radius_m)
-    axial = {f: float((np.array(gmsh.model.occ.getCenterOfMass(2, f)) - s.log_centre)
-                      @ s.log_axis) for f in log_faces}
-    out[LOG_BACK] = [min(log_faces, key=axial.get)]
-    out[LOG_FRONT] = sorted(f for f in log_faces if axial[f] >= 0.5 * L - d - 1e-9 * L)
-    out[LOG_MANTLE] = sorted(set(log_faces) - set(out[LOG_BACK]) - set(out[LOG_FRONT]))
     return out
 
 
 # ---- the bodies apart: the dam without the log, the log in its own frame (dam/reuse.py) --
-def build_dam_only(comm, scenario, strip_m, water_levels_m=()):
-    """The dam and its foundation without the log (2D), refined along a strip of the
-    upstream face that logs can hit.
+def build_dam_only(comm, scenario, strip_m, water_levels_m=(), patch_y_m=None):
+    """The dam and its foundation without the log, refined along a strip of the upstream
+    face that logs can hit (in 3D a patch: the strip between ``patch_y_m`` = (y0, y1),
+    meshes/dam_apart_3d.py).
 
     ``strip_m`` = (z0, z1): the elevations (m) bounding the strip, 0 < z0 < z1 < dam height;
     the face has nodes there and at each of ``water_levels_m`` (and the scenario's own water
@@ -298,8 +320,9 @@ def build_dam_only(comm, scenario, strip_m, water_levels_m=()):
     facet_tags, info).
     """
     s = scenario
-    if s.dim != 2:
-        raise InputError(f"dim={s.dim}: the dam mesh without the log is built in 2D only")
+    if s.dim == 3:
+        from .dam_apart_3d import build_dam_only_3d
+        return build_dam_only_3d(comm, s, strip_m, patch_y_m, water_levels_m)
     z0, z1 = (float(z) for z in strip_m)
     if not 0.0 < z0 < z1 < s.dam_height_m:
         raise InputError(f"strip_m={(z0, z1)}: need 0 < z0 < z1 < dam_height_m="
@@ -343,17 +366,23 @@ def _model_dam_only_2d(s, info, face_levels):
     return info
 
 
-def build_log(comm, length_m, diameter_m, h_m, end=None):
-    """The 2D log (a plane-strain slab ``length_m`` × ``diameter_m``) in its own frame: axis
-    along x, centre at the origin, front end (tag ``log_front``) at x = +L/2, shaped by
-    ``end`` (a :class:`~.log_end.LogEnd`; None: flat); elements of size ``h_m``. Tags:
-    cells ``log``; facets ``log_front``, ``log_back``, ``log_upper``, ``log_lower``.
-    Returns (mesh, cell_tags, facet_tags, info)."""
+def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2):
+    """The log in its own frame: axis along x, centre at the origin, front end (tag
+    ``log_front``) at x = +L/2, shaped by ``end`` (a :class:`~.log_end.LogEnd`; None: flat);
+    elements of size ``h_m``. In 2D a plane-strain slab ``length_m`` × ``diameter_m``
+    (facets ``log_front``, ``log_back``, ``log_upper``, ``log_lower``), in 3D a round log
+    (faces ``log_front``, ``log_back``, ``log_mantle``). Cells ``log``. Returns (mesh,
+    cell_tags, facet_tags, info)."""
     from ._check import positive
     L, D, h = (positive(n, v) for n, v in (("length_m", length_m), ("diameter_m", diameter_m),
                                            ("h_m", h_m)))
     end = (LogEnd() if end is None else end).check(D, ("end.shape", "end.chamfer_m",
                                                        "end.radius_m"))
+    if dim == 3:
+        from .dam_apart_3d import build_log_3d
+        return build_log_3d(comm, L, D, h, end)
+    if dim != 2:
+        raise InputError(f"dim={dim!r}: the log is meshed in 2D or 3D")
     info = dict(dim=2, length_m=L, diameter_m=D, h_m=h, end_shape=end.shape)
     return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, end, info), gdim=2)
 

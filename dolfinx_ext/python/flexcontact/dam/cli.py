@@ -11,8 +11,9 @@ from pathlib import Path
 WHAT_IF_INPUTS = ("log_speed_m_s", "log_pitch_deg", "log_length_m", "log_diameter_m",
                   "wood_density_kg_m3", "friction_mu", "water_level_m",
                   "added_mass_coefficient", "wood_crushing_strength_Pa", "log_end_shape",
-                  "log_end_chamfer_m", "log_end_radius_m")
-"""The scenario's inputs a what-if may change (2D: no yaw); the rest are the model's base."""
+                  "log_end_chamfer_m", "log_end_radius_m", "log_yaw_deg", "log_across_m")
+"""The scenario's inputs a what-if may change (yaw and the place across the block in 3D);
+the rest are the model's base."""
 
 
 def add_parser(sub) -> None:
@@ -47,12 +48,13 @@ def prepare(args) -> int:
     from .reuse import sweep_time_step_s
     cfg = load(args.config)
     base, _, scenarios = build_scenarios(cfg)
-    if base.dim != 2:
-        raise ValueError(f"base.dim={base.dim}: dam models are 2D for now")
+    from .dam_model import face_region_m
     levels = [s.water_level_m for s in scenarios] or [base.water_level_m]
     out = args.out or Path("results") / "dam_model" / args.config.stem
+    strip, patch = face_region_m(base, scenarios, (min(levels), max(levels)))
     write(base, sweep_time_step_s(scenarios or [base]), (min(levels), max(levels)), out,
-          levels=sorted(set(levels)) if len(set(levels)) <= 8 else None)
+          levels=sorted(set(levels)) if len(set(levels)) <= 8 else None, strip_m=strip,
+          patch_y_m=patch)
     return 0
 
 
@@ -79,7 +81,7 @@ def what_if(args) -> int:
     for key in ("peak_force_filtered_N_per_m", "peak_force_N_per_m", "impulse_N_s_per_m",
                 "heel_stress_static_Pa", "heel_stress_impact_Pa", "toe_stress_impact_Pa",
                 "peak_tensile_stress_Pa", "contact_duration_s"):
-        q = quantity(key, 2)
+        q = quantity(key, ev.base.dim)
         print(f"  {q.words}: {q.show(out[key])} {q.unit}")
     print(f"  dam: {counts.get('restorations', {})} restored, factorizations "
           f"{counts['factorizations']}; back-substitutions {counts['back_substitutions']}")

@@ -41,7 +41,8 @@ def expected_contact_s(s, dam) -> float:
     dam's own round trip (base width) is added as a bound as stage 2 does."""
     c_log = math.sqrt(s.wood.E_Pa / (s.wood.rho_kg_m3 * (1.0 + s.added_mass_coefficient)))
     a = s.log_axis
-    extent = s.log_length_m * abs(a[0]) + s.log_diameter_m * abs(a[1])
+    extent = s.log_length_m * abs(a[0]) + s.log_diameter_m * math.sqrt(max(1.0 - a[0] ** 2,
+                                                                           0.0))
     c_dam = math.sqrt(s.concrete.E_Pa / s.concrete.rho_kg_m3)
     return min(2.0 * extent / c_log, 2.0 * s.base_width_m / c_dam)
 
@@ -115,13 +116,13 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     convolution ("convolution_s") are added."""
     if after_contact not in AFTER_CONTACT:
         raise ValueError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
-    h, theta, d = dam.dt, dam.theta, 2
-    R = rotation(s.log_pitch_deg)
+    h, theta, d = dam.dt, dam.theta, s.dim
+    R = rotation(s.log_pitch_deg, s.log_yaw_deg, d)
     slave = log.placed_front(R, s.log_centre)
     pairs = build_surface_pairs([("node_to_surface", slave, dam.face)], d)
     m = pairs.m
-    F = np.zeros((2 * pairs.x.shape[0],) * 2)
-    n_log = 2 * m
+    F = np.zeros((d * pairs.x.shape[0],) * 2)
+    n_log = d * m
     F[:n_log, :n_log] = log.W_front_global(R)
     F[n_log:, n_log:] = dam.W_face
     kernel = _cpp.ImpactContact(d, F, pairs.x, kernel_pairs(pairs), np.full(m, s.friction_mu),
@@ -133,7 +134,8 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     V0 = s.log_speed_m_s * np.asarray(s.log_axis, float)
     bd, bl = _Body(dam), _Body(log)
     u_face0 = static.u.x.array[dam.face_dofs]
-    impact = np.array([0.0, s.log_front_point[-1]])
+    impact = np.array(s.log_front_point, float)
+    impact[0] = 0.0  # on the face
     cells = dam.stress_cells(impact, offset_m)
     n = run_steps(s, dam)
     records, peak_principal, p_peak = [], -math.inf, 0.0
@@ -264,7 +266,7 @@ def _replay(dam, body, first: int, stop: int, h: float, theta: float, section: d
 def _log_values(log, vec, R, rigid) -> np.ndarray:
     """Front-end DOF values of a local-frame log vector, rotated to the dam's frame, plus
     the rigid part ``rigid`` (d,) on every node; node-major."""
-    local = vec.array_r[log.front_dofs].reshape(-1, 2)
+    local = vec.array_r[log.front_dofs].reshape(-1, R.shape[0])
     return (local @ R.T + rigid[None, :]).reshape(-1)
 
 
@@ -290,7 +292,7 @@ def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_pea
         "impulse_N_s_per_m": m["impulse"],
         "contact_episodes": m["episodes"],
         "log_momentum_change_N_s_per_m": float(dp[0]),
-        "log_momentum_change_vertical_N_s_per_m": float(dp[1]),
+        "log_momentum_change_vertical_N_s_per_m": float(dp[-1]),
         "log_mass_kg_per_m": log.mass_kg_per_m,
         "log_velocity_after_m_s": float(s.log_speed_m_s * s.log_axis[0]
                                         + dp[0] / log.mass_kg_per_m),

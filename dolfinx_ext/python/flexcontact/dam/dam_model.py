@@ -68,6 +68,20 @@ class StaticState:
     section_foundation: BaseSection
 
 
+def default_patch_y_m(base, yaw_deg: float = 15.0, margin_m: float = 1.0):
+    """3D: the y range (m) of the face patch that the front end of the base scenario's log,
+    at its place across the block, can hit at any yaw up to ± max(|its yaw|, ``yaw_deg``),
+    widened by ``margin_m`` each side and kept on the block; None in 2D."""
+    if base.dim != 3:
+        return None
+    yaw = np.radians(max(abs(base.log_yaw_deg), yaw_deg))
+    reach = (0.5 * base.log_length_m * np.cos(np.radians(base.log_pitch_deg)) * np.sin(yaw)
+             + base.log_radius_m)
+    y = float(base.log_centre[1])
+    return (float(max(y - reach - margin_m, 0.0)),
+            float(min(y + reach + margin_m, base.dam_width_m)))
+
+
 def default_strip_m(base, water_levels_m, pitch_deg: float = 15.0,
                     margin_m: float = 1.0) -> tuple[float, float]:
     """Elevations (m) of the face strip that the front end of the base scenario's log can
@@ -83,16 +97,41 @@ def default_strip_m(base, water_levels_m, pitch_deg: float = 15.0,
     return float(z0), float(z1)
 
 
+def face_region_m(base, scenarios, water_levels_m=None, margin_m: float = 1.0):
+    """(strip_m, patch_y_m): the face strip's elevations and, in 3D, the patch's y range
+    (None in 2D) that hold the base's default region and the front end of every one of
+    ``scenarios`` with ``margin_m`` to spare each side, kept on the face."""
+    lo, hi = _levels(base, water_levels_m)
+    z0, z1 = default_strip_m(base, (lo, hi))
+    patch = default_patch_y_m(base)
+    for s in scenarios:
+        a = s.log_axis
+        end = s.log_centre + 0.5 * s.log_length_m * a
+        rz = s.log_radius_m * np.sqrt(max(1.0 - a[-1] ** 2, 0.0)) + margin_m
+        z0, z1 = min(z0, end[-1] - rz), max(z1, end[-1] + rz)
+        if patch is not None:
+            ry = s.log_radius_m * np.sqrt(max(1.0 - a[1] ** 2, 0.0)) + margin_m
+            patch = (min(patch[0], end[1] - ry), max(patch[1], end[1] + ry))
+    z0 = max(z0, 0.5 * base.h_far_m)
+    z1 = min(z1, base.dam_height_m - 0.5 * base.h_impact_m)
+    if patch is not None:
+        patch = (float(max(patch[0], 0.0)), float(min(patch[1], base.dam_width_m)))
+    return (float(z0), float(z1)), patch
+
+
 class DamModel:
     """The dam + foundation of ``base`` (without the log), factored for a sweep at
     ``dt_s``; see the module docstring. ``water_levels_m`` = (lo, hi): the range of water
-    levels of the sweep (the face has nodes at both). Serial (``comm`` of one rank).
+    levels of the sweep (the face has nodes at both). ``strip_m``: the face strip's
+    elevations (default_strip_m); in 3D ``patch_y_m``: its y range (default_patch_y_m).
+    Serial (``comm`` of one rank).
 
     Counters: ``factorizations`` and ``back_substitutions``, dicts by stage.
     """
 
     def __init__(self, base, dt_s: float, water_levels_m=None, comm=MPI.COMM_SELF,
-                 strip_m=None, theta: float = 0.5, restored: Optional[dict] = None):
+                 strip_m=None, theta: float = 0.5, restored: Optional[dict] = None,
+                 patch_y_m=None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: DamModel is serial (one rank; "
                              "parallel sweeps run one DamModel per process)")
@@ -101,6 +140,8 @@ class DamModel:
         self.base, self.dt, self.theta, self.comm = base, float(dt_s), float(theta), comm
         self.water_levels_m = (lo, hi)
         self.strip_m = tuple(strip_m) if strip_m is not None else default_strip_m(base, (lo, hi))
+        self.patch_y_m = (tuple(float(y) for y in patch_y_m) if patch_y_m is not None
+                          else default_patch_y_m(base))
         # restored: {"stage1": factor of K, "stage2": factor of Ŵ, "W_face": array,
         # "face_compliance_x": array} read from a model file (dam/model_file.py): nothing is
         # factored, the restorations are counted instead.
@@ -112,10 +153,11 @@ class DamModel:
         self.back_substitutions = {"dam_stage1": 0, "dam_stage2": 0}
         self.timings = {}
         t0 = time.perf_counter()
-        self.mesh = DamMesh(*dam_mesh.build_dam_only(comm, base, self.strip_m, (lo, hi)))
+        self.mesh = DamMesh(*dam_mesh.build_dam_only(comm, base, self.strip_m, (lo, hi),
+                                                     self.patch_y_m))
         self.timings["mesh_s"] = time.perf_counter() - t0
         self.V = compat.vector_space(self.mesh.msh)
-        self.kind = "plane_strain"
+        self.kind = "plane_strain" if base.dim == 2 else "3d"
         self.materials = {T.DAM: base.concrete, T.FOUNDATION: base.rock}
         self.bcs = stage2_supports(base, self.V, self.mesh)
         self._statics: dict = {}
@@ -213,10 +255,14 @@ class DamModel:
         msh, ft = self.mesh.msh, self.mesh.facet_tags
         fdim = msh.topology.dim - 1
         up = np.sort(ft.indices[ft.values == T.DAM_UPSTREAM]).astype(np.int32)
-        mid = dolfinx.mesh.compute_midpoints(msh, fdim, up)[:, msh.geometry.dim - 1]
+        mid = dolfinx.mesh.compute_midpoints(msh, fdim, up)[:, :msh.geometry.dim]
         z0, z1 = self.strip_m
         tol = 1e-9 * self.base.dam_height_m
-        inside = up[(mid >= z0 - tol) & (mid <= z1 + tol)]
+        keep = (mid[:, -1] >= z0 - tol) & (mid[:, -1] <= z1 + tol)
+        if self.patch_y_m is not None:
+            y0, y1 = self.patch_y_m
+            keep &= (mid[:, 1] >= y0 - tol) & (mid[:, 1] <= y1 + tol)
+        inside = up[keep]
         return dolfinx.mesh.meshtags(msh, fdim, inside, np.full(inside.size, STRIP, np.int32))
 
     def new_vector(self) -> PETSc.Vec:
@@ -241,7 +287,7 @@ class DamModel:
         blocks = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim - 1,
                                                      ft.indices[ft.values == T.DAM_BASE])
         pts = V.tabulate_dof_coordinates()[blocks, :s.dim]
-        B, width = s.base_width_m, 1.0
+        B, width = s.base_width_m, self.section_width_m
         self.section_gradients = {}
         for name in SECTION_QUANTITIES:
             c = K_dam.createVecRight()
@@ -259,6 +305,12 @@ class DamModel:
             g.destroy()
         self.heel_gradient = self.section_gradients["sigma_heel_Pa"]
         K_dam.destroy()
+
+    @property
+    def section_width_m(self) -> float:
+        """The base section's width along the dam axis: 1 m in 2D (values per metre), the
+        block's width in 3D."""
+        return 1.0 if self.base.dim == 2 else float(self.base.dam_width_m)
 
     def face_compliance(self, axis: int = 0) -> np.ndarray:
         """(K⁻¹)_ii for the face DOFs i along ``axis`` (m/N, cached): with the dam's energy

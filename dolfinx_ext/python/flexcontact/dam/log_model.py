@@ -33,11 +33,19 @@ from ..pairing import _candidate_surface
 from ..errors import InputError
 
 
-def rotation(pitch_deg: float) -> np.ndarray:
-    """2×2 rotation taking the log's local x axis to its axis in the dam's frame (front
-    end up for a positive pitch)."""
+def rotation(pitch_deg: float, yaw_deg: float = 0.0, dim: int = 2) -> np.ndarray:
+    """The rotation (2×2 or 3×3) taking the log's local x axis to its axis in the dam's
+    frame (DamScenario.log_axis): pitched front end up for a positive pitch, then in 3D
+    yawed about the vertical z."""
     t = math.radians(pitch_deg)
-    return np.array([[math.cos(t), -math.sin(t)], [math.sin(t), math.cos(t)]])
+    c, s = math.cos(t), math.sin(t)
+    if dim == 2:
+        return np.array([[c, -s], [s, c]])
+    p = math.radians(yaw_deg)
+    pitch = np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+    yaw = np.array([[math.cos(p), -math.sin(p), 0.0], [math.sin(p), math.cos(p), 0.0],
+                    [0.0, 0.0, 1.0]])
+    return yaw @ pitch
 
 
 def rotate_blocks(W: np.ndarray, R: np.ndarray) -> np.ndarray:
@@ -51,21 +59,24 @@ def rotate_blocks(W: np.ndarray, R: np.ndarray) -> np.ndarray:
 class LogMesh:
     """The log's mesh in its own frame with its stiffness K and its unit-density mass M₁,
     shared by every density of one log geometry: a new density only rescales M (M = ρ M₁),
-    so it costs no meshing and no form compilation (the forms hold no density). Serial."""
+    so it costs no meshing and no form compilation (the forms hold no density). ``dim``:
+    2 (a plane-strain slab) or 3 (a round log). Serial."""
 
     def __init__(self, length_m: float, diameter_m: float, E: float, nu: float,
-                 h_m: float = None, comm=MPI.COMM_SELF, end=None):
+                 h_m: float = None, comm=MPI.COMM_SELF, end=None, dim: int = 2):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         self.length_m, self.diameter_m = float(length_m), float(diameter_m)
         h = h_m if h_m is not None else diameter_m / 4
-        self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(comm, length_m,
-                                                                         diameter_m, h, end)
+        self.dim = int(dim)
+        self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(
+            comm, length_m, diameter_m, h, end, dim=self.dim)
         self.V = compat.vector_space(self.msh)
         mat = Material(E_Pa=E, nu=nu, rho_kg_m3=1.0, name="wood")
         u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
         dx = ufl.Measure("dx", domain=self.msh)
-        a = dolfinx.fem.form(elasticity_form(u, v, mat, dx, "plane_strain"))
+        kind = "plane_strain" if self.dim == 2 else "3d"
+        a = dolfinx.fem.form(elasticity_form(u, v, mat, dx, kind))
         m = dolfinx.fem.form(mass_form(u, v, 1.0, dx))
         n = self.V.dofmap.index_map.size_local * self.V.dofmap.index_map_bs
         marker = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
@@ -74,7 +85,7 @@ class LogMesh:
         marker.destroy()
         self.front = _candidate_surface(self.V, self.facet_tags, T.LOG_FRONT)
         self.front_dofs = np.asarray(self.front["dofs"], np.int64).reshape(-1)
-        self.x_nodes = self.V.tabulate_dof_coordinates()[:, :2].copy()
+        self.x_nodes = self.V.tabulate_dof_coordinates()[:, :self.dim].copy()
 
 
 class LogModel:
@@ -84,12 +95,14 @@ class LogModel:
     ρ (1 + C_a); ``E``, ``nu``: the wood's along-grain modulus (Pa) and Poisson's ratio;
     ``h_m``: element size (default D/4); ``mesh``: a :class:`LogMesh` of the same length,
     diameter, E and ν to reuse (made here when None); ``end``: the front end's
-    :class:`~flexcontact.meshes.log_end.LogEnd` (None: flat). Serial.
+    :class:`~flexcontact.meshes.log_end.LogEnd` (None: flat); ``dim``: 2 or 3 (that of
+    ``mesh`` when given). ``mass_kg_per_m``: the log's mass with its added mass (kg/m in
+    2D, kg in 3D). Serial.
     """
 
     def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
                  E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
-                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None, end=None):
+                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None, end=None, dim: int = 2):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
@@ -100,7 +113,8 @@ class LogModel:
         self.factorizations, self.back_substitutions = 0, 0
         t0 = time.perf_counter()
         self.mesh = mesh if mesh is not None else LogMesh(length_m, diameter_m, E, nu, h_m, comm,
-                                                          end)
+                                                          end, dim)
+        self.dim = self.mesh.dim
         self.msh, self.cell_tags, self.facet_tags = (self.mesh.msh, self.mesh.cell_tags,
                                                      self.mesh.facet_tags)
         self.V = self.mesh.V
@@ -119,9 +133,10 @@ class LogModel:
         marker.set(1.0)
         self.W_hat = setup.iteration_matrix(self.K, self.M, self.dt, self.theta, (0.0, 0.0),
                                             marker)
-        ones = [self.new_vector() for _ in range(2)]
+        d = self.dim
+        ones = [self.new_vector() for _ in range(d)]
         for k, o in enumerate(ones):
-            o.array[k::2] = 1.0
+            o.array[k::d] = 1.0
         Mo = self.new_vector()
         self.M.mult(ones[0], Mo)
         self.mass_kg_per_m = float(Mo.sum())  # Σ M over the x DOFs: the log's mass
@@ -165,8 +180,13 @@ class LogModel:
         return out
 
     def rotation_rad(self, w: PETSc.Vec) -> float:
-        """The rigid rotation (rad, counter-clockwise) best fitting the displacement w:
-        Σ x × w / Σ |x|² about the log's centre."""
+        """The rigid rotation (rad) best fitting the displacement w about the log's centre:
+        in 2D Σ x × w / Σ |x|² (counter-clockwise), in 3D the size of the small-rotation
+        vector θ minimising Σ |w − θ × x|² (the translation is removed first)."""
         x = self.x_nodes
-        wv = w.array_r.reshape(-1, 2)
-        return float(np.sum(x[:, 0] * wv[:, 1] - x[:, 1] * wv[:, 0]) / np.sum(x * x))
+        wv = w.array_r.reshape(-1, self.dim)
+        if self.dim == 2:
+            return float(np.sum(x[:, 0] * wv[:, 1] - x[:, 1] * wv[:, 0]) / np.sum(x * x))
+        xc, wc = x - x.mean(axis=0), wv - wv.mean(axis=0)
+        J = np.eye(3) * np.sum(xc * xc) - xc.T @ xc  # the nodes' "inertia"
+        return float(np.linalg.norm(np.linalg.solve(J, np.cross(xc, wc).sum(axis=0))))

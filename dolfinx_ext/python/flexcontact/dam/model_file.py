@@ -36,11 +36,15 @@ MODEL_FORMAT = 1
 """The model directory's format: a model of another format is refused."""
 
 
-def inputs_of(base, dt_s: float, water_levels_m, strip_m) -> dict:
-    """What the model depends on, as plain JSON values."""
-    return {"base": base.as_dict(), "dt_s": float(dt_s),
-            "water_levels_m": [float(z) for z in water_levels_m],
-            "strip_m": [float(z) for z in strip_m]}
+def inputs_of(base, dt_s: float, water_levels_m, strip_m, patch_y_m=None) -> dict:
+    """What the model depends on, as plain JSON values (in 3D, the face patch's y range
+    too)."""
+    out = {"base": base.as_dict(), "dt_s": float(dt_s),
+           "water_levels_m": [float(z) for z in water_levels_m],
+           "strip_m": [float(z) for z in strip_m]}
+    if patch_y_m is not None:
+        out["patch_y_m"] = [float(y) for y in patch_y_m]
+    return out
 
 
 def inputs_hash(inputs: dict) -> str:
@@ -48,17 +52,19 @@ def inputs_hash(inputs: dict) -> str:
 
 
 def prepare(base, dt_s: float, water_levels_m, path, levels=None,
-            lags: int | None = None, progress=print) -> dict:
+            lags: int | None = None, progress=print, strip_m=None, patch_y_m=None) -> dict:
     """Build and factor the dam of ``base`` at ``dt_s`` for the water levels
     ``water_levels_m`` = (lowest, highest), and write its model to the directory ``path``
     (replaced atomically if it exists). ``levels``: the water levels whose static state is
     stored (default: both ends of the range); ``lags``: response-function lags tabulated
     now (default: twice the steps of the base scenario's run; a longer run extends them on
-    load, from the saved adjoint state, counted). Returns the manifest."""
+    load, from the saved adjoint state, counted); ``strip_m``, ``patch_y_m``: the face
+    region condensed (default: DamModel's). Returns the manifest."""
     from .dam_model import DamModel
     path = Path(path)
     t0 = time.perf_counter()
-    dam = DamModel(base, dt_s, water_levels_m, MPI.COMM_SELF)
+    dam = DamModel(base, dt_s, water_levels_m, MPI.COMM_SELF, strip_m=strip_m,
+                   patch_y_m=patch_y_m)
     imap = dam.V.dofmap.index_map
     progress(f"dam meshed, assembled and factored: {imap.size_global * dam.V.dofmap.index_map_bs} "
              f"DOFs, face strip {dam.strip_m[0]:.3f}..{dam.strip_m[1]:.3f} m "
@@ -88,7 +94,7 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
         for i, (z, st) in enumerate(statics.items()):
             arrays[f"static_u_{i}"] = st.u.x.array
         np.savez(tmp / "arrays.npz", **arrays)
-        inputs = inputs_of(base, dt_s, dam.water_levels_m, dam.strip_m)
+        inputs = inputs_of(base, dt_s, dam.water_levels_m, dam.strip_m, dam.patch_y_m)
         from .. import __version__
         manifest = {
             "format": MODEL_FORMAT, "flexcontact_version": __version__,
@@ -195,7 +201,8 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
     restored["W_face"] = arrays["W_face"]
     restored["face_compliance_x"] = arrays["face_compliance_x"]
     dam = DamModel(base, inputs["dt_s"], tuple(inputs["water_levels_m"]), comm,
-                   strip_m=tuple(inputs["strip_m"]), restored=restored)
+                   strip_m=tuple(inputs["strip_m"]), restored=restored,
+                   patch_y_m=inputs.get("patch_y_m"))
     if dam.mesh_hash() != manifest["mesh_sha256"] or not np.array_equal(
             dam.face_dofs, arrays["face_dofs"]):
         import gmsh

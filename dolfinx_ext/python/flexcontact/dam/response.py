@@ -111,7 +111,7 @@ class ResponseFunctions:
             for k in range(min(P.shape[0], n)):
                 y[k:] += C[: n - k, k]      # Δq after step i (index i) takes G_{i−k} · P_k
             out[q] = y
-        B, width = self.dam.base.base_width_m, 1.0
+        B, width = self.dam.base.base_width_m, self.dam.section_width_m
         N, M = out["normal_force_N"], out["moment_centre_Nm"]
         out["sigma_heel_Pa"] = -N / (B * width) + 6.0 * M / (width * B * B)
         out["sigma_toe_Pa"] = -N / (B * width) - 6.0 * M / (width * B * B)

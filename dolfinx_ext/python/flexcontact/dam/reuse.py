@@ -14,13 +14,15 @@ per-body condensation; they touch only through contact):
 
 :class:`ScenarioEvaluator` is what a sweep calls: ``evaluate(scenario) -> dict`` of plain
 floats, ``counts()`` of factorizations and back-substitutions per body. One time step
-serves the whole sweep (:func:`sweep_time_step_s`). 2D only.
+serves the whole sweep (:func:`sweep_time_step_s`). 2D and 3D (the 3D block's face patch
+and a round log placed by its pitch, yaw and position across the block).
 """
 from __future__ import annotations
 
 import time
 from typing import Optional
 
+import numpy as np
 from mpi4py import MPI
 
 from .. import impact_setup as setup
@@ -63,7 +65,9 @@ class ScenarioEvaluator:
     ``dt_s``: the sweep's time step (default: :func:`sweep_time_step_s` of ``[base]``);
     ``water_levels_m``: (lowest, highest) water level of the sweep (default: the base's);
     ``comm``: one rank (a parallel sweep runs one evaluator per process); ``strip_m``:
-    the elevations of the face strip (default: dam_model.default_strip_m); ``offset_m``:
+    the elevations of the face strip (default: dam_model.default_strip_m); in 3D
+    ``patch_y_m``: its range across the block (default: dam_model.default_patch_y_m);
+    ``offset_m``:
     the distance from the first-contact point at which the peak principal stress is read;
     ``after_contact``: "convolve" (default: the dam is not stepped once the log has left it
     for good, the base section then comes from its response functions) or "step".
@@ -73,9 +77,8 @@ class ScenarioEvaluator:
                  water_levels_m: Optional[tuple[float, float]] = None,
                  comm: MPI.Comm = MPI.COMM_SELF, *,
                  strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0,
+                 patch_y_m: Optional[tuple[float, float]] = None,
                  after_contact: str = "convolve", dam: Optional[DamModel] = None):
-        if base.dim != 2:
-            raise InputError(f"dim={base.dim}: the scenario evaluator is 2D only")
         if base.westergaard:
             raise InputError("westergaard=True: the reservoir's added mass depends on the water "
                              "level, so one factored dam cannot serve a sweep over it; use the "
@@ -91,7 +94,8 @@ class ScenarioEvaluator:
         # dam: a DamModel already built for this base and time step (restored from a model
         # file, dam/model_file.py); otherwise it is built and factored here.
         self.dam = dam if dam is not None else DamModel(base, self.dt, water_levels_m, comm,
-                                                        strip_m=strip_m)
+                                                        strip_m=strip_m,
+                                                        patch_y_m=patch_y_m)
         self.dam.static_state(base.water_level_m)
         self._logs: dict = {}
         self._steps_s = self._log_mesh_s = 0.0
@@ -108,15 +112,27 @@ class ScenarioEvaluator:
                              f"{(lo, hi)} the dam was built for (water_levels_m)")
         setup.check_resolution(self.dt, expected_contact_s(scenario, self.dam),
                                "2L/c of the log along the face normal")
+        a = scenario.log_axis
+        end = scenario.log_centre + 0.5 * scenario.log_length_m * a  # the end's centre
+
+        def reach(k):  # the end's disc (a segment in 2D) along axis k
+            return scenario.log_radius_m * np.sqrt(max(1.0 - a[k] ** 2, 0.0))
+
         z0, z1 = self.dam.strip_m
-        front = scenario.log_centre[-1] + 0.5 * scenario.log_length_m * scenario.log_axis[-1]
-        reach = scenario.log_radius_m * abs(scenario.log_axis[0])
-        if not (z0 <= front - reach and front + reach <= z1):
+        front, r = end[-1], reach(len(a) - 1)
+        if not (z0 <= front - r and front + r <= z1):
             raise InputError(
                 f"log_pitch_deg={scenario.log_pitch_deg!r}, water_level_m="
                 f"{scenario.water_level_m!r}: the log's front end (elevations "
-                f"{front - reach:.3f}..{front + reach:.3f} m) leaves the face strip "
+                f"{front - r:.3f}..{front + r:.3f} m) leaves the face strip "
                 f"{z0:.3f}..{z1:.3f} m of this dam (strip_m)")
+        if self.dam.patch_y_m is not None:
+            (y0, y1), y, r = self.dam.patch_y_m, end[1], reach(1)
+            if not (y0 <= y - r and y + r <= y1):
+                raise InputError(
+                    f"log_yaw_deg={scenario.log_yaw_deg!r}: the log's front end (y "
+                    f"{y - r:.3f}..{y + r:.3f} m) leaves the face patch {y0:.3f}..{y1:.3f} m "
+                    f"across this dam block (patch_y_m)")
 
     def log_model(self, s: DamScenario) -> LogModel:
         """The cached LogModel of the scenario's log (made on first use)."""
@@ -127,12 +143,13 @@ class ScenarioEvaluator:
             if mesh_key not in self._log_meshes:
                 t0 = time.perf_counter()
                 self._log_meshes[mesh_key] = LogMesh(
-                    *geometry, h_m=self.base.h_impact_m, comm=self.dam.comm, end=s.log_end)
+                    *geometry, h_m=self.base.h_impact_m, comm=self.dam.comm, end=s.log_end,
+                    dim=s.dim)
                 self._log_mesh_s += time.perf_counter() - t0
             self._logs[key] = LogModel(
                 s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
                 s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm,
-                mesh=self._log_meshes[mesh_key])
+                mesh=self._log_meshes[mesh_key], dim=s.dim)
         return self._logs[key]
 
     def evaluate(self, scenario: DamScenario) -> dict[str, float]:

@@ -11,7 +11,8 @@ vertical downstream face under the crest down to the *knee*, then the downstream
 The log floats: its axis elevation follows from the water level and its draft (see
 :mod:`flexcontact.dam.buoyancy`); it is pitched (front end up for a positive angle) and, in
 3D, yawed about the vertical axis, and is placed so that its point nearest the dam is
-``log_gap_m`` upstream of the face, at mid-width of the block in 3D. A pitched log keeps the
+``log_gap_m`` upstream of the face, in 3D with its centre at y = ``log_across_m`` (default:
+mid-width of the block). A pitched log keeps the
 centre elevation of the horizontal floating log (exact for s = 1/2 by the symmetry of the
 segment area about d = R, a small-angle approximation otherwise).
 
@@ -98,6 +99,8 @@ class DamScenario:
     log_pitch_deg: float = 10.0
     log_yaw_deg: float = 0.0
     log_gap_m: float = 0.02
+    # 3D: where the log's centre is across the block, y (m); None: mid-width
+    log_across_m: Optional[float] = None
     # the front end (meshes/log_end.py): "flat", "chamfered" (bevel log_end_chamfer_m,
     # None: D/8) or "rounded" (a spherical cap of radius log_end_radius_m >= D/2, None: D)
     log_end_shape: str = "flat"
@@ -259,7 +262,7 @@ class DamScenario:
         c[0] = -self.log_gap_m - self._log_reach(ex)
         c[-1] = self.log_axis_elevation_m
         if self.dim == 3:
-            c[1] = 0.5 * self.dam_width_m
+            c[1] = 0.5 * self.dam_width_m if self.log_across_m is None else self.log_across_m
         return c
 
     @property

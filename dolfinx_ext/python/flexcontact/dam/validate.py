@@ -96,6 +96,16 @@ def _check_log(s):
                            "faces the dam)")
     if s.dim == 2 and s.log_yaw_deg != 0:
         _fail("log_yaw_deg", s.log_yaw_deg, "a yaw angle needs the 3D variant (dim=3)")
+    if s.log_across_m is not None:
+        if s.dim == 2:
+            _fail("log_across_m", s.log_across_m, "a place across the block needs the 3D "
+                                                  "variant (dim=3); None in 2D")
+        if not (_real(s.log_across_m) and s.log_radius_m <= s.log_across_m
+                <= s.dam_width_m - s.log_radius_m):
+            _fail("log_across_m", s.log_across_m,
+                  f"the log's centre must be within the block, at least its radius "
+                  f"{s.log_radius_m:.4g} m from both joints (0 to dam_width_m="
+                  f"{s.dam_width_m!r})")
     s.log_end.check(s.log_diameter_m)
     rho, rho_w = s.wood.rho_kg_m3, s.water_density_kg_m3
     if not 0 < rho < rho_w:

@@ -37,7 +37,7 @@ from . import distributions
 from .errors import ConfigError
 
 SWEPT = ("log_length_m", "log_diameter_m", "wood_density_kg_m3", "log_speed_m_s",
-         "log_pitch_deg", "log_yaw_deg", "friction_mu", "water_level_m",
+         "log_pitch_deg", "log_yaw_deg", "log_across_m", "friction_mu", "water_level_m",
          "added_mass_coefficient", "wood_crushing_strength_Pa", "log_end_shape",
          "log_end_chamfer_m", "log_end_radius_m", "concrete_tensile_strength_Pa")
 """Inputs a sweep may vary; ``wood_density_kg_m3`` is the wood Material's ``rho_kg_m3``.

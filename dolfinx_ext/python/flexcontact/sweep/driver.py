@@ -19,26 +19,32 @@ from .table import ResultTable
 def prepare(cfg: SweepConfig) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
     import), the sweep's time step and water levels, and, with engine.model for the "reuse"
-    evaluator in 2D, the dam model every worker loads (prepared there once if it is not
+    evaluator, the dam model every worker loads (prepared there once if it is not
     there yet). Without engine.model each worker factors the dam itself: in 2D that is
     faster per step, since a restored factor has no Schur split (bench/README.md)."""
     base, points, scenarios = build_scenarios(cfg)
     cls, _ = evaluators.resolve(cfg.engine["evaluator"])
     dt = evaluators.sweep_time_step(cfg.engine["evaluator"], scenarios)
     levels = [float(s.water_level_m) for s in scenarios]
-    spec = EvaluatorSpec(cfg.engine["evaluator"], base, dt, (min(levels), max(levels)))
+    face = None
+    if cfg.engine["evaluator"] == "reuse":
+        from ..dam.dam_model import face_region_m
+        strip, patch = face_region_m(base, scenarios, (min(levels), max(levels)))
+        face = {"strip_m": strip, "patch_y_m": patch}
+    spec = EvaluatorSpec(cfg.engine["evaluator"], base, dt, (min(levels), max(levels)),
+                         face=face)
     prep = {"base": base, "points": points, "scenarios": scenarios, "spec": spec, "dt_s": dt,
             "checker": None}
     model = cfg.engine.get("model")
-    if cfg.engine["evaluator"] == "reuse" and base.dim == 2 and model is not None:
-        prep["model"] = dam_model(Path(model), base, dt, levels)
+    if cfg.engine["evaluator"] == "reuse" and model is not None:
+        prep["model"] = dam_model(Path(model), base, dt, levels, face)
         spec = prep["spec"] = replace(spec, model=str(model))
     if hasattr(cls, "check"):
         prep["checker"] = check_all(spec, points, scenarios)
     return prep
 
 
-def dam_model(path: Path, base, dt: float, levels: list) -> dict:
+def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = None) -> dict:
     """The dam model at ``path`` for this sweep: prepared there once (atomically) if absent,
     else checked against the sweep's dam and time step (ConfigError naming what differs).
     Returns {"path", "prepared_this_run", "counts"}: the factorizations its preparation
@@ -51,7 +57,7 @@ def dam_model(path: Path, base, dt: float, levels: list) -> dict:
             distinct = sorted(set(levels))
             manifest = model_file.prepare(base, dt, (min(levels), max(levels)), path,
                                           levels=distinct if len(distinct) <= 8 else None,
-                                          progress=lambda *a: None)
+                                          progress=lambda *a: None, **(face or {}))
         else:
             manifest = model_file.read_manifest(path)
             model_file.check_inputs(manifest, base, dt)
@@ -172,10 +178,16 @@ def _sum_timings(rows: list) -> dict:
 
 def convergence(prep: dict, worst: dict) -> dict:
     """Each output's most unfavourable scenario again at refine + 1 (in this process, with
-    an evaluator of its own on the finer base and the sweep's time step)."""
+    an evaluator of its own on the finer base and the sweep's time step). On the 3D block
+    the factored-dam evaluator's worst are re-run by the monolithic one: the check then
+    covers the face patch's condensation as well as the mesh."""
     spec = prep["spec"]
-    fine = EvaluatorSpec(spec.name, spec.base.replace(refine=spec.base.refine + 1),
-                         spec.dt_s, spec.water_levels_m)
+    name = spec.name
+    if name == "reuse" and spec.base.dim == 3:
+        name = "monolithic"
+    face = spec.face if name == spec.name else None
+    fine = EvaluatorSpec(name, spec.base.replace(refine=spec.base.refine + 1),
+                         spec.dt_s, spec.water_levels_m, face=face)
     ev, cache, out = fine.build(), {}, {}
     for o, w in worst.items():
         if w is None:
@@ -185,6 +197,7 @@ def convergence(prep: dict, worst: dict) -> dict:
             cache[w["id"]] = ev.evaluate(s.replace(refine=s.refine + 1))
         v, v1 = float(w["value"]), float(cache[w["id"]][o])
         out[o] = {"id": w["id"], "refine": s.refine, "value": v, "value_refined": v1,
+                  "evaluator_refined": name,
                   "relative_change": (v1 - v) / abs(v) if v else math.nan,
                   "outputs_refined": cache[w["id"]]}
     return out

@@ -73,6 +73,9 @@ class EvaluatorSpec:
     model: Optional[str] = None
     """A dam model directory (dam/model_file.py) every worker loads instead of factoring
     the dam (the "reuse" evaluator only)."""
+    face: Optional[dict] = None
+    """The "reuse" evaluator's face region, {"strip_m", "patch_y_m"}, holding every
+    scenario of the sweep (dam_model.face_region_m)."""
 
     def build(self):
         from mpi4py import MPI
@@ -83,7 +86,7 @@ class EvaluatorSpec:
             return model_file.load(self.model, MPI.COMM_SELF)
         cls, _ = resolve(self.name)
         return cls(self.base, dt_s=self.dt_s, water_levels_m=list(self.water_levels_m),
-                   comm=MPI.COMM_SELF)
+                   comm=MPI.COMM_SELF, **(self.face or {}))
 
 
 _STATE: dict = {}

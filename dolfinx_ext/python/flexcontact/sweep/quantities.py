@@ -126,6 +126,7 @@ INPUTS = {
     "log_speed_m_s": Quantity("Log speed", unit="m/s"),
     "log_pitch_deg": Quantity("Log pitch", unit="°"),
     "log_yaw_deg": Quantity("Log yaw", unit="°"),
+    "log_across_m": Quantity("Log's place across the block (y of its centre)", unit="m"),
     "log_length_m": Quantity("Log length", unit="m"),
     "log_diameter_m": Quantity("Log diameter", unit="m"),
     "wood_density_kg_m3": Quantity("Wood density", unit="kg/m³"),

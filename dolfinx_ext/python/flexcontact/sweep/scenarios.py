@@ -93,9 +93,11 @@ def build_scenarios(cfg) -> tuple:
     """(base, points, scenarios): every scenario built and checked; a bad one raises
     ConfigError naming the scenario id, its inputs and the failing parameter's value."""
     base = base_scenario(cfg)
-    if "log_yaw_deg" in cfg.parameters and base.dim != 3:
-        raise ConfigError(f"parameters.log_yaw_deg: a yaw angle needs base.dim = 3 "
-                          f"(base.dim={base.dim!r})")
+    for name, what in (("log_yaw_deg", "a yaw angle"),
+                       ("log_across_m", "a place across the block")):
+        if name in cfg.parameters and base.dim != 3:
+            raise ConfigError(f"parameters.{name}: {what} needs base.dim = 3 "
+                              f"(base.dim={base.dim!r})")
     points = sample_points(cfg)
     scenarios = []
     for i, p in enumerate(points):

@@ -201,8 +201,13 @@ def markdown(summary: dict, inputs: list) -> str:
                              f"{qo.show(d['max'])} | {three_figures(d['p_over_median'])} | "
                              f"{three_figures(d['p_over_p10'])} |")
     if s.get("convergence"):
-        L += ["", "## Mesh convergence of the most unfavourable scenarios", "",
-              "| output | scenario | refine | value | refine + 1 | value | relative change |",
+        L += ["", "## Mesh convergence of the most unfavourable scenarios", ""]
+        by = {c.get("evaluator_refined") for c in s["convergence"].values()}
+        if "monolithic" in by and s.get("evaluator") == "reuse":
+            L += ["Re-run at refine + 1 by the monolithic evaluator (dam and log meshed and "
+                  "factored together): the change covers the mesh and the factored dam's "
+                  "face patch.", ""]
+        L += ["| output | scenario | refine | value | refine + 1 | value | relative change |",
               "|---|---|---|---|---|---|---|"]
         for o, c in s["convergence"].items():
             L.append(f"| {q[o].label()} | {c['id']} | {c['refine']} | {q[o].show(c['value'])} "

@@ -1,0 +1,164 @@
+"""The factored-dam evaluator (dam/reuse.py) on the 3D dam block, against the monolithic
+stage 1 + 2.
+
+Two references:
+
+* **identical meshes**: the evaluator's own meshes (the dam block without the log, the
+  round log in its own frame, rotated and moved into place) merged node for node into one
+  mesh (meshes/merge.py), on which the monolithic stages run. The two methods then solve
+  the same discrete problem: every output agrees to 1e-8 (measured 1e-12 .. 1e-14);
+* **each one's own mesh** at the 3D default sizes (far 6 m, impact 0.4 m): the two meshes
+  differ, and so do their answers, by the discretisation error.
+
+Serial (COMM_SELF: the evaluator is one process's).
+"""
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from flexcontact.dam import DamScenario
+from flexcontact.dam.coupled_step import run_impact
+from flexcontact.dam.log_model import rotation
+from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
+from flexcontact.dam.stage1 import DamMesh, solve_stage1
+from flexcontact.dam.stage2 import solve_stage2
+from flexcontact.meshes.merge import merge
+from flexcontact.sweep.monolithic import MonolithicEvaluator
+
+COMM = MPI.COMM_SELF
+BASE = DamScenario(dim=3, mesh_size_far_m=6.0, mesh_size_impact_m=0.4)
+LEVELS = (BASE.water_level_m - 1.0, BASE.water_level_m)
+SCENARIOS = [
+    BASE,
+    # yawed, off-centre, pitched the other way, lower water, a rounded end that crushes
+    BASE.replace(log_yaw_deg=12.0, log_across_m=6.0, log_pitch_deg=-4.0,
+                 water_level_m=26.0, log_end_shape="rounded", log_end_crushes=True,
+                 log_speed_m_s=3.0, friction_mu=0.3),
+]
+COMPARED = ("impulse_N_s_per_m", "peak_force_N_per_m", "peak_force_filtered_N_per_m",
+            "contact_duration_s", "heel_stress_static_Pa", "peak_tensile_stress_Pa",
+            "peak_contact_pressure_Pa", "log_momentum_change_N_s_per_m")
+
+
+@pytest.fixture(scope="module")
+def evaluator():
+    return ScenarioEvaluator(BASE, sweep_time_step_s(SCENARIOS), LEVELS, COMM)
+
+
+def monolithic_on_the_same_meshes(evaluator, s) -> dict:
+    """The monolithic stages 1 + 2 of ``s`` on the evaluator's dam mesh and its log mesh
+    placed by the scenario's rotation and centre, for as many steps as the evaluator's run:
+    the outputs under the evaluator's names."""
+    log = evaluator.log_model(s)
+    R = rotation(s.log_pitch_deg, s.log_yaw_deg, s.dim)
+    c = s.log_centre
+    dm = evaluator.dam.mesh
+    mesh = DamMesh(*merge(COMM, [(dm.msh, dm.cell_tags, dm.facet_tags, None),
+                                 (log.msh, log.cell_tags, log.facet_tags,
+                                  lambda x: c[None, :] + x @ R.T)]))
+    r1 = solve_stage1(s, mesh=mesh, comm=COMM)
+    n = run_impact_steps(evaluator, s)
+    r2 = solve_stage2(s, r1, dt_s=evaluator.dt, duration_s=n * evaluator.dt, comm=COMM)
+    m = r2.metrics
+    heel = max(r1.section.sigma_heel_Pa, r2.section_extremes()["sigma_heel_max_Pa"])
+    return {"impulse_N_s_per_m": m["impulse"], "peak_force_N_per_m": m["peak_force"],
+            "peak_force_filtered_N_per_m": m["peak_force_filtered"],
+            "contact_duration_s": m["contact_duration_s"],
+            "heel_stress_static_Pa": r1.section.sigma_heel_Pa, "heel_stress_impact_Pa": heel,
+            "peak_tensile_stress_Pa": r2.peak_tensile_stress_Pa,
+            "peak_contact_pressure_Pa": r2.peak_contact_pressure_Pa,
+            "log_momentum_change_N_s_per_m": r2.log_momentum_change,
+            "steps": r2.timings_s["steps_n"]}
+
+
+def run_impact_steps(evaluator, s) -> int:
+    from flexcontact.dam.coupled_step import run_steps
+    return run_steps(s, evaluator.dam)
+
+
+@pytest.mark.parametrize("k", range(len(SCENARIOS)))
+def test_identical_meshes_give_the_monolithic_answer(evaluator, k):
+    """Every output within 1e-8 (relative; the heel stress's change relative to itself) of
+    the monolithic run on the same meshes, with the dam stepped to the end and with its
+    base section convolved after the contact."""
+    s = SCENARIOS[k]
+    ref = monolithic_on_the_same_meshes(evaluator, s)
+    got = evaluator.evaluate(s)
+    assert got["steps"] == ref["steps"]
+    for key in COMPARED:
+        assert got[key] == pytest.approx(ref[key], rel=1e-8), key
+    static = ref["heel_stress_static_Pa"]
+    change = ref["heel_stress_impact_Pa"] - static
+    assert change > 0
+    assert abs(got["heel_stress_impact_Pa"] - static - change) <= 1e-8 * change
+    assert got["dam_steps_convolved"] > 0  # the dam not stepped after the contact
+
+
+@pytest.mark.parametrize("k", range(len(SCENARIOS)))
+def test_convolved_section_equals_the_stepped_one_in_3d(evaluator, k):
+    """The base section's history from the response functions equals the stepped dam's at
+    every step (1e-8 of the largest change); the face impulses along x sum to the impulse
+    (1e-9)."""
+    s = SCENARIOS[k]
+    dam, log = evaluator.dam, evaluator.log_model(s)
+    static = dam.static_state(s.water_level_m)
+    stepped = run_impact(dam, log, s, static, 1.0, "step", histories=True)
+    convolved = run_impact(dam, log, s, static, 1.0, "convolve", histories=True)
+    for q, ref in stepped["history"].items():
+        scale = np.abs(ref).max()
+        assert scale > 0
+        assert np.abs(convolved["history"][q] - ref).max() <= 1e-8 * scale, q
+    assert (convolved["dam_back_substitutions"] + convolved["dam_steps_convolved"]
+            == stepped["dam_back_substitutions"])
+    assert abs(stepped["face_impulses"][:, 0::3].sum() - stepped["impulse_N_s_per_m"]) \
+        <= 1e-9 * stepped["impulse_N_s_per_m"]
+
+
+@pytest.fixture(scope="module")
+def own_meshes(evaluator):
+    """The base scenario on each method's own mesh at the 3D default sizes."""
+    return evaluator.evaluate(BASE), MonolithicEvaluator(BASE, evaluator.dt).evaluate(BASE)
+
+
+def test_each_ones_own_mesh(own_meshes):
+    """Impulse within 1 %, filtered peak force within 2 %, peak principal stress 1 m from
+    the contact within 5 %. Measured: +0.20 %, +0.94 %, −3.5 %."""
+    got, ref = own_meshes
+    assert got["impulse_N_s_per_m"] == pytest.approx(ref["impulse_N_s_per_m"], rel=0.01)
+    assert got["peak_force_filtered_N_per_m"] == pytest.approx(
+        ref["peak_force_filtered_N_per_m"], rel=0.02)
+    assert got["peak_tensile_stress_Pa"] == pytest.approx(ref["peak_tensile_stress_Pa"],
+                                                          rel=0.05)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "Δσ_heel of the two meshes differs by −8.5 % at far 6 m / impact 0.4 m (−5.1 % at "
+    "4 m / 0.4 m, −0.7 % at 3 m / 0.3 m): the discretisation error of the coarse default "
+    "far mesh, not the method (identical meshes agree to 1e-12)"))
+def test_heel_stress_change_on_each_ones_own_mesh(own_meshes):
+    """Δσ_heel = σ_heel during the impact − σ_heel static within 5 %."""
+    got, ref = own_meshes
+    d_got = got["heel_stress_impact_Pa"] - got["heel_stress_static_Pa"]
+    d_ref = ref["heel_stress_impact_Pa"] - ref["heel_stress_static_Pa"]
+    assert d_got == pytest.approx(d_ref, rel=0.05)
+
+
+def test_a_log_beyond_the_face_patch_is_named(evaluator):
+    """A log whose front end leaves the condensed patch across the block is refused before
+    computing, naming the parameter."""
+    lo, hi = evaluator.dam.patch_y_m
+    s = BASE.replace(log_across_m=min(hi + 1.0, BASE.dam_width_m - BASE.log_radius_m))
+    with pytest.raises(ValueError, match="log_yaw_deg=.*face patch"):
+        evaluator.evaluate(s)
+
+
+@pytest.mark.parametrize("bad, name", [(dict(log_across_m=0.1), "log_across_m=0.1"),
+                                       (dict(log_across_m=float("nan")), "log_across_m=nan")])
+def test_bad_place_across_the_block(bad, name):
+    with pytest.raises(ValueError, match=name):
+        BASE.replace(**bad)
+
+
+def test_a_place_across_is_3d_only():
+    with pytest.raises(ValueError, match="log_across_m=5.0"):
+        DamScenario(log_across_m=5.0)
