@@ -25,6 +25,7 @@ from petsc4py import PETSc
 import dolfinx.fem
 
 from .. import _cpp, compat
+from ..dense_factor import DenseFactor
 from .. import impact_setup as setup
 from ..forms import Material, elasticity_form, mass_form
 from ..meshes import dam as dam_mesh
@@ -97,7 +98,8 @@ class LogModel:
     diameter, E and ν to reuse (made here when None); ``end``: the front end's
     :class:`~flexcontact.meshes.log_end.LogEnd` (None: flat); ``dim``: 2 or 3 (that of
     ``mesh`` when given). ``mass_kg_per_m``: the log's mass with its added mass (kg/m in
-    2D, kg in 3D). Serial.
+    2D, kg in 3D). ``factor_kind``: "dense" (a log of at most dense_factor.DENSE_LIMIT
+    DOFs, held as dense blocks) or "mumps_schur". Serial.
     """
 
     def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
@@ -120,9 +122,18 @@ class LogModel:
         self.V = self.mesh.V
         self._factor()
         self.front, self.front_dofs = self.mesh.front, self.mesh.front_dofs
-        F, self.factor, info = _cpp.flexibility(self.W_hat, self.front_dofs, "schur")
-        self.W_front = np.asarray(F)
-        self.factorizations += int(info["factorizations"])
+        n = self.W_hat.getSize()[0]
+        if DenseFactor.worth_it(n):
+            # A log of a few hundred DOFs: dense blocks beat the sparse solve's overhead.
+            self.factor = DenseFactor(self.W_hat, self.front_dofs)
+            self.W_front = self.factor.W
+            self.factorizations += 1
+            self.factor_kind = "dense"
+        else:
+            F, self.factor, info = _cpp.flexibility(self.W_hat, self.front_dofs, "schur")
+            self.W_front = np.asarray(F)
+            self.factorizations += int(info["factorizations"])
+            self.factor_kind = "mumps_schur"
         self.setup_s = time.perf_counter() - t0
 
     def _factor(self):
