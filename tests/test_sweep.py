@@ -422,7 +422,7 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     geometry, the reusing evaluator factors K (stage 1) and K_eff (stage 2) once each, plus
     the log's own factorization: three in all, whatever the number of scenarios (serial:
     one evaluator). With a dam model (engine.model) it is prepared once (K and K_eff
-    factored for the dam and again for the saved factors: two each), the evaluator restores
+    factored once each, as the factors it saves), the evaluator restores
     both factors and factors nothing of the dam, and the table is the same to 1e-10."""
     pytest.importorskip("flexcontact.dam.reuse")
     raw = {"parameters": {"log_speed_m_s": {"values": [1.5, 3.0]},
@@ -439,7 +439,7 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     assert s["counts"]["factorizations"]["total"] == 1, s["counts"]      # the log
     assert s["counts"]["restorations"]["total"] == 2, s["counts"]       # K and K_eff
     assert s["dam_model"]["prepared_this_run"]
-    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 2, "dam_stage2": 2}
+    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1}
     for o, w in own["worst"].items():
         assert s["worst"][o]["id"] == w["id"]
         assert s["worst"][o]["value"] == pytest.approx(w["value"], rel=1e-10)

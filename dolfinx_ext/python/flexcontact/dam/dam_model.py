@@ -131,7 +131,7 @@ class DamModel:
 
     def __init__(self, base, dt_s: float, water_levels_m=None, comm=MPI.COMM_SELF,
                  strip_m=None, theta: float = 0.5, restored: Optional[dict] = None,
-                 patch_y_m=None):
+                 patch_y_m=None, saveable: bool = False):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: DamModel is serial (one rank; "
                              "parallel sweeps run one DamModel per process)")
@@ -146,6 +146,9 @@ class DamModel:
         # "face_compliance_x": array} read from a model file (dam/model_file.py): nothing is
         # factored, the restorations are counted instead.
         self._restored = restored
+        # saveable: K and Ŵ factored as SavedFactors (model_file.prepare writes them, no
+        # second factorization); Ŵ then has no Schur split, and W_face comes from its solves.
+        self._saveable = bool(saveable) and restored is None
         self._compliance = ({0: restored["face_compliance_x"]}
                             if restored is not None and "face_compliance_x" in restored else {})
         self.factorizations = {"dam_stage1": 0, "dam_stage2": 0}
@@ -179,6 +182,12 @@ class DamModel:
         if self._restored is not None:
             self._ksp1, self._factor1 = None, self._restored["stage1"]
             self.restorations["dam_stage1"] += 1
+            self.timings["stage1_factor_s"] = time.perf_counter() - t0
+            return
+        if self._saveable:
+            from ..saved_factor import factor_matrix
+            self._ksp1, self._factor1 = None, factor_matrix(K1)
+            self.factorizations["dam_stage1"] += 1
             self.timings["stage1_factor_s"] = time.perf_counter() - t0
             return
         ksp = PETSc.KSP().create(K1.getComm())
@@ -243,12 +252,34 @@ class DamModel:
                                  f"{self.face_dofs.size} DOFs")
             self.restorations["dam_stage2"] += 1
             self.flex_info = {"restored": True}
+        elif self._saveable:
+            from ..saved_factor import factor_matrix
+            self.factor = factor_matrix(self.W_hat)
+            self.factorizations["dam_stage2"] += 1
+            self.W_face = self._flexibility_by_solves()
+            self.flex_info = {"saveable": True, "solves": int(self.face_dofs.size)}
         else:
             F, self.factor, info = _cpp.flexibility(self.W_hat, self.face_dofs, "schur")
             self.W_face = np.asarray(F)
             self.factorizations["dam_stage2"] += int(info["factorizations"])
             self.flex_info = dict(info)
         self.timings["stage2_factor_s"] = time.perf_counter() - t0
+
+    def _flexibility_by_solves(self) -> np.ndarray:
+        """W_face = S Ŵ⁻¹ Sᵀ column by column, one back-substitution per face DOF (counted
+        in "dam_stage2"), symmetrised."""
+        dofs = self.face_dofs
+        e, x = self.new_vector(), self.new_vector()
+        W = np.empty((dofs.size, dofs.size))
+        for j, i in enumerate(dofs):
+            e.zeroEntries()
+            e.array[i] = 1.0
+            self.factor.solve(e, x)
+            W[:, j] = x.array_r[dofs]
+        self.back_substitutions["dam_stage2"] += int(dofs.size)
+        e.destroy()
+        x.destroy()
+        return 0.5 * (W + W.T)
 
     def _strip_tags(self):
         """MeshTags of the upstream-face facets inside the strip (their midpoints)."""

@@ -64,7 +64,7 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
     path = Path(path)
     t0 = time.perf_counter()
     dam = DamModel(base, dt_s, water_levels_m, MPI.COMM_SELF, strip_m=strip_m,
-                   patch_y_m=patch_y_m)
+                   patch_y_m=patch_y_m, saveable=True)
     imap = dam.V.dofmap.index_map
     progress(f"dam meshed, assembled and factored: {imap.size_global * dam.V.dofmap.index_map_bs} "
              f"DOFs, face strip {dam.strip_m[0]:.3f}..{dam.strip_m[1]:.3f} m "
@@ -83,11 +83,8 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
     tmp.mkdir(parents=True)
     try:
         factors = {}
-        for name, matrix in (("stage1", dam._K1), ("stage2", dam.W_hat)):
-            f = saved_factor.factor_matrix(matrix)
-            dam.factorizations[f"dam_{name}"] += 1
+        for name, f in (("stage1", dam._factor1), ("stage2", dam.factor)):
             factors[name] = saved_factor.save_factor(f, tmp, name)
-            f.destroy()
         arrays = {"W_face": dam.W_face, "face_dofs": dam.face_dofs,
                   "face_compliance_x": compliance}
         arrays.update(responses.saved())
