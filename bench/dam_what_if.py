@@ -1,12 +1,14 @@
 """What a what-if question costs once the dam is saved (dam/model_file.py).
 
 Prepares the dam model of ``examples/sweep_small.toml`` (the 2D section at its default
-mesh), then runs ``python3 -m flexcontact dam what-if MODEL ...`` ``--runs`` times, each a
+mesh; with ``--dim 3`` ``examples/sweep_3d.toml``, the 3D block at its default mesh), then
+runs ``python3 -m flexcontact dam what-if MODEL ...`` ``--runs`` times, each a
 new process, on the same scenario, and records in one run: the whole command's wall time,
 the time to load the model and to answer (from the command's own --json), the counts
-(nothing of the dam factored), and the machine's load. Writes bench/dam_what_if.json.
+(nothing of the dam factored), and the machine's load. Writes bench/dam_what_if.json
+(bench/dam_what_if_3d.json with ``--dim 3``).
 
-    /usr/bin/python3 bench/dam_what_if.py [--runs 5]
+    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3]
 """
 import argparse
 import json
@@ -21,18 +23,25 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 ap = argparse.ArgumentParser(description=__doc__)
 ap.add_argument("--runs", type=int, default=5)
-ap.add_argument("--out", default=str(Path(__file__).with_name("dam_what_if.json")))
+ap.add_argument("--dim", type=int, choices=(2, 3), default=2)
+ap.add_argument("--out", default=None)
 args = ap.parse_args()
+if args.out is None:
+    args.out = str(Path(__file__).with_name("dam_what_if.json" if args.dim == 2
+                                            else "dam_what_if_3d.json"))
+CONFIG = "examples/sweep_small.toml" if args.dim == 2 else "examples/sweep_3d.toml"
 sys.path.insert(0, str(ROOT / "bench"))
 from machine import machine  # noqa: E402
 
 ASK = ["--log-speed-m-s", "3", "--log-pitch-deg", "10", "--log-length-m", "12",
        "--water-level-m", "26"]
+if args.dim == 3:
+    ASK += ["--log-yaw-deg", "10", "--log-across-m", "6.5"]
 with tempfile.TemporaryDirectory() as tmp:
     model = Path(tmp) / "model"
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-m", "flexcontact", "dam", "prepare",
-                    str(ROOT / "examples" / "sweep_small.toml"), "--out", str(model)],
+                    str(ROOT / CONFIG), "--out", str(model)],
                    check=True, cwd=ROOT, capture_output=True)
     prepare_s = time.perf_counter() - t0
     runs = []
@@ -47,8 +56,9 @@ with tempfile.TemporaryDirectory() as tmp:
                      "counts": out["counts"]})
     size = sum(p.stat().st_size for p in model.iterdir())
 result = {
-    "what": "dam what-if from a saved model, 2D section at its default mesh",
-    "config": "examples/sweep_small.toml", "scenario": ASK, "prepare_s": prepare_s,
+    "what": ("dam what-if from a saved model, "
+             + ("2D section" if args.dim == 2 else "3D block") + " at its default mesh"),
+    "config": CONFIG, "scenario": ASK, "prepare_s": prepare_s,
     "model_bytes": size, "runs": runs,
     "median_s": {k: statistics.median(r[k] for r in runs)
                  for k in ("command_s", "load_s", "evaluate_s")},

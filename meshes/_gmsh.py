@@ -79,6 +79,19 @@ def generate(comm, name: str, build_model, gdim: int):
     return msh, cell_tags, facet_tags, info
 
 
+def mesh_uniform(dim: int, h: float) -> None:
+    """Mesh the current model's ``dim``-entities with elements of size ``h`` everywhere,
+    then restore gmsh's default size bounds for the next model of a session the caller
+    opened."""
+    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+    try:
+        gmsh.model.mesh.generate(dim)
+    finally:
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
+
+
 def physical(dim: int, entities, tag: int, name: str):
     """Add a named physical group of ``dim``-entities with number ``tag``."""
     gmsh.model.addPhysicalGroup(dim, list(entities), tag)

@@ -395,11 +395,5 @@ def _model_log_2d(L, D, h, end, info):
     _gmsh.physical(2, [surface], LOG, NAMES[LOG])
     for tag in (LOG_LOWER, LOG_FRONT, LOG_UPPER, LOG_BACK):
         _gmsh.physical(1, curves[tag], tag, NAMES[tag])
-    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-    try:
-        gmsh.model.mesh.generate(2)
-    finally:  # gmsh's defaults again, for the next model of a session the caller opened
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
+    _gmsh.mesh_uniform(2, h)
     return info

@@ -94,13 +94,6 @@ def _model_log(L, D, h, end, info):
     _gmsh.physical(3, [vol], LOG, NAMES[LOG])
     for tag, fs in log_faces_3d(vol, centre, axis, L, 0.5 * D, end).items():
         _gmsh.physical(2, fs, tag, NAMES[tag])
-    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    try:
-        gmsh.model.mesh.generate(3)
-    finally:  # gmsh's defaults again, for the next model of a session the caller opened
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
+    _gmsh.mesh_uniform(3, h)
     return info
 
