@@ -52,6 +52,25 @@ class DenseFactor:
         self.W = 0.5 * (self.W + self.W.T)
         self._z = None
 
+    def arrays(self, prefix: str) -> dict:
+        """The blocks, to be saved (named ``prefix`` + name)."""
+        return {f"{prefix}n": np.array([self.n]), f"{prefix}c": self.c,
+                f"{prefix}A_ii_inv": self.A_ii_inv, f"{prefix}T": self.T, f"{prefix}W": self.W}
+
+    @classmethod
+    def from_arrays(cls, arrays: dict, prefix: str) -> "DenseFactor":
+        """The factor of :meth:`arrays` (no factorization)."""
+        self = cls.__new__(cls)
+        self.n = int(np.asarray(arrays[f"{prefix}n"])[0])
+        self.c = np.asarray(arrays[f"{prefix}c"], np.int64)
+        interior = np.ones(self.n, bool)
+        interior[self.c] = False
+        self.i = np.flatnonzero(interior)
+        self.A_ii_inv, self.T, self.W = (np.asarray(arrays[f"{prefix}{k}"])
+                                         for k in ("A_ii_inv", "T", "W"))
+        self._z = None
+        return self
+
     @staticmethod
     def worth_it(n: int) -> bool:
         return n <= DENSE_LIMIT

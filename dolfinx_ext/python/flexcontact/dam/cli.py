@@ -44,7 +44,7 @@ def main(args) -> int:
 def prepare(args) -> int:
     from ..sweep import load
     from ..sweep.scenarios import build_scenarios
-    from .model_file import prepare as write
+    from .model_file import logs_of, prepare as write
     from .reuse import sweep_time_step_s
     cfg = load(args.config)
     base, _, scenarios = build_scenarios(cfg)
@@ -54,7 +54,7 @@ def prepare(args) -> int:
     strip, patch = face_region_m(base, scenarios, (min(levels), max(levels)))
     write(base, sweep_time_step_s(scenarios or [base]), (min(levels), max(levels)), out,
           levels=sorted(set(levels)) if len(set(levels)) <= 8 else None, strip_m=strip,
-          patch_y_m=patch)
+          patch_y_m=patch, logs=logs_of(base, scenarios))
     return 0
 
 

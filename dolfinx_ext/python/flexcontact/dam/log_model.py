@@ -88,6 +88,43 @@ class LogMesh:
         self.front_dofs = np.asarray(self.front["dofs"], np.int64).reshape(-1)
         self.x_nodes = self.V.tabulate_dof_coordinates()[:, :self.dim].copy()
 
+    FRONT_KEYS = ("x", "dofs", "normal", "area", "facets", "facet_normal", "open_edge")
+
+    def arrays(self, prefix: str) -> dict:
+        """What a model file keeps of this log mesh (no mesh: K, M₁ as CSR, the nodes and
+        the front end's surface), as arrays named ``prefix`` + name."""
+        out = {f"{prefix}x_nodes": self.x_nodes, f"{prefix}dims": np.array(
+            [self.dim, self.length_m, self.diameter_m])}
+        for name, A in (("K", self.K), ("M1", self.M1)):
+            ai, aj, av = A.getValuesCSR()
+            out.update({f"{prefix}{name}_indptr": ai, f"{prefix}{name}_indices": aj,
+                        f"{prefix}{name}_data": av})
+        out.update({f"{prefix}front_{k}": np.asarray(self.front[k]) for k in self.FRONT_KEYS
+                    if k in self.front})
+        return out
+
+    @classmethod
+    def from_arrays(cls, arrays: dict, prefix: str) -> "LogMesh":
+        """The log mesh of :meth:`arrays`, without a mesh (nothing meshed or assembled)."""
+        self = cls.__new__(cls)
+        dim, self.length_m, self.diameter_m = arrays[f"{prefix}dims"]
+        self.dim = int(dim)
+        self.msh = self.cell_tags = self.facet_tags = self.V = None
+        self.x_nodes = np.asarray(arrays[f"{prefix}x_nodes"])
+        n = self.x_nodes.shape[0] * self.dim
+        mats = []
+        for name in ("K", "M1"):
+            csr = tuple(np.asarray(arrays[f"{prefix}{name}_{k}"])
+                        for k in ("indptr", "indices", "data"))
+            A = PETSc.Mat().createAIJ(size=(n, n), csr=csr, comm=PETSc.COMM_SELF)
+            A.assemble()
+            mats.append(A)
+        self.K, self.M1 = mats
+        self.front = {k: np.asarray(arrays[f"{prefix}front_{k}"]) for k in self.FRONT_KEYS
+                      if f"{prefix}front_{k}" in arrays}
+        self.front_dofs = np.asarray(self.front["dofs"], np.int64).reshape(-1)
+        return self
+
 
 class LogModel:
     """One log geometry and material at the time step ``dt_s``, factored once.
@@ -104,10 +141,12 @@ class LogModel:
 
     def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
                  E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
-                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None, end=None, dim: int = 2):
+                 comm=MPI.COMM_SELF, mesh: "LogMesh" = None, end=None, dim: int = 2,
+                 factor: "DenseFactor" = None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
+        self.restorations = 0
         self.material = Material(E_Pa=E, nu=nu, rho_kg_m3=rho_effective_kg_m3,
                                  name="wood+added mass")
         self.length_m, self.diameter_m = float(length_m), float(diameter_m)
@@ -123,7 +162,15 @@ class LogModel:
         self._factor()
         self.front, self.front_dofs = self.mesh.front, self.mesh.front_dofs
         n = self.W_hat.getSize()[0]
-        if DenseFactor.worth_it(n):
+        if factor is not None:
+            # Restored from a model file (dam/model_file.py): nothing factored.
+            if factor.n != n or not np.array_equal(factor.c, self.front_dofs):
+                raise InputError(f"a saved log factor of {factor.n} DOFs does not fit this "
+                                 f"log of {n} DOFs")
+            self.factor, self.W_front = factor, factor.W
+            self.restorations += 1
+            self.factor_kind = "dense"
+        elif DenseFactor.worth_it(n):
             # A log of a few hundred DOFs: dense blocks beat the sparse solve's overhead.
             self.factor = DenseFactor(self.W_hat, self.front_dofs)
             self.W_front = self.factor.W

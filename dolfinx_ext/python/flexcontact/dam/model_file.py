@@ -52,14 +52,17 @@ def inputs_hash(inputs: dict) -> str:
 
 
 def prepare(base, dt_s: float, water_levels_m, path, levels=None,
-            lags: int | None = None, progress=print, strip_m=None, patch_y_m=None) -> dict:
+            lags: int | None = None, progress=print, strip_m=None, patch_y_m=None,
+            logs=()) -> dict:
     """Build and factor the dam of ``base`` at ``dt_s`` for the water levels
     ``water_levels_m`` = (lowest, highest), and write its model to the directory ``path``
     (replaced atomically if it exists). ``levels``: the water levels whose static state is
     stored (default: both ends of the range); ``lags``: response-function lags tabulated
     now (default: twice the steps of the base scenario's run; a longer run extends them on
     load, from the saved adjoint state, counted); ``strip_m``, ``patch_y_m``: the face
-    region condensed (default: DamModel's). Returns the manifest."""
+    region condensed (default: DamModel's); ``logs``: scenarios whose log models are kept
+    too (one per distinct log; logs held dense only, dense_factor.DENSE_LIMIT). Returns the
+    manifest."""
     from .dam_model import DamModel
     path = Path(path)
     t0 = time.perf_counter()
@@ -88,6 +91,7 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
         arrays = {"W_face": dam.W_face, "face_dofs": dam.face_dofs,
                   "face_compliance_x": compliance}
         arrays.update(responses.saved())
+        kept_logs = _log_arrays(base, dam, logs, arrays)
         for i, (z, st) in enumerate(statics.items()):
             arrays[f"static_u_{i}"] = st.u.x.array
         np.savez(tmp / "arrays.npz", **arrays)
@@ -101,7 +105,7 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
                                  "section": statics[z].section.__dict__,
                                  "section_foundation": statics[z].section_foundation.__dict__}
                         for i, z in enumerate(levels)},
-            "factors": factors, "counts": dam.counts(),
+            "factors": factors, "counts": dam.counts(), "logs": kept_logs,
             "files": {"arrays.npz": _file_entry(tmp / "arrays.npz")}}
         (tmp / "manifest.json").write_text(json.dumps(manifest, indent=1, default=_plain))
         old = path.parent / f".{path.name}.old-{os.getpid()}"
@@ -216,7 +220,49 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
         dam._statics[float(st["water_level_m"])] = StaticState(
             float(st["water_level_m"]), u, BaseSection(**_section(st["section"])),
             BaseSection(**_section(st["section_foundation"])))
-    return ScenarioEvaluator(base, comm=comm, dam=dam, **evaluator_options)
+    ev = ScenarioEvaluator(base, comm=comm, dam=dam, **evaluator_options)
+    for entry in manifest.get("logs", []):
+        from ..dense_factor import DenseFactor
+        from .log_model import LogMesh
+        p = entry["prefix"]
+        ev.logs.restore(DamScenario.from_dict(entry["scenario"]),
+                        LogMesh.from_arrays(arrays, p), DenseFactor.from_arrays(arrays, p + "f_"))
+    return ev
+
+
+MAX_LOGS = 16
+"""A model keeps at most this many log models of its config."""
+
+
+def logs_of(base, scenarios) -> list:
+    """One scenario per distinct log of a config (the base's first), when there are at
+    most MAX_LOGS of them (a continuous density gives one log per scenario: the base's
+    alone then)."""
+    from .reuse import log_key
+    distinct = {}
+    for s in [base, *scenarios]:
+        distinct.setdefault(log_key(s), s)
+    return list(distinct.values()) if len(distinct) <= MAX_LOGS else [base]
+
+
+def _log_arrays(base, dam, logs, arrays: dict) -> list:
+    """Build the log model of each distinct log among ``logs`` at the dam's time step, put
+    its arrays in ``arrays`` and return the manifest's entries."""
+    from .reuse import LogCache, log_key
+    distinct = {}
+    for s in logs:
+        distinct.setdefault(log_key(s), s)
+    cache = LogCache(dam.dt, base.h_impact_m, dam.comm)
+    entries = []
+    for i, s in enumerate(distinct.values()):
+        log = cache.get(s)
+        if log.factor_kind != "dense":
+            continue  # a large log is built on the spot when asked
+        p = f"log{i}_"
+        arrays.update(log.mesh.arrays(p))
+        arrays.update(log.factor.arrays(p + "f_"))
+        entries.append({"prefix": p, "scenario": s.as_dict()})
+    return entries
 
 
 def _section(d: dict) -> dict:

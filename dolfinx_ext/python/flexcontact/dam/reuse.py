@@ -59,6 +59,50 @@ def log_key(s: DamScenario) -> tuple:
             s.wood.E_Pa, s.wood.nu, s.log_end)
 
 
+class LogCache:
+    """The log models of one dam at the time step ``dt_s``: one LogMesh per log geometry
+    (its mesh, K and unit mass, every density), one LogModel per log (log_key), each made
+    on first use or restored from a model file. Elements of ``h_m``."""
+
+    def __init__(self, dt_s: float, h_m: float, comm):
+        self.dt, self.h_m, self.comm = float(dt_s), float(h_m), comm
+        self.models: dict = {}
+        self.meshes: dict = {}
+        self.mesh_s = 0.0
+
+    @staticmethod
+    def _mesh_key(s: DamScenario) -> tuple:
+        return (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu, s.log_end)
+
+    def get(self, s: DamScenario) -> LogModel:
+        key = log_key(s)
+        if key not in self.models:
+            mesh_key = self._mesh_key(s)
+            if mesh_key not in self.meshes:
+                t0 = time.perf_counter()
+                self.meshes[mesh_key] = LogMesh(*mesh_key[:4], h_m=self.h_m, comm=self.comm,
+                                                end=s.log_end, dim=s.dim)
+                self.mesh_s += time.perf_counter() - t0
+            self.models[key] = self._model(s, self.meshes[mesh_key])
+        return self.models[key]
+
+    def restore(self, s: DamScenario, mesh, factor) -> None:
+        """Adopt the log of scenario ``s`` from a model file: its LogMesh without a mesh and
+        its dense factor (counted as a restoration, not a factorization)."""
+        self.meshes.setdefault(self._mesh_key(s), mesh)
+        self.models[log_key(s)] = self._model(s, mesh, factor)
+
+    def _model(self, s: DamScenario, mesh, factor=None) -> LogModel:
+        return LogModel(
+            s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
+            s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.h_m, comm=self.comm, mesh=mesh,
+            dim=s.dim, factor=factor)
+
+    def setup_s(self) -> float:
+        """Seconds of meshing, factorization and condensation of every log so far."""
+        return self.mesh_s + sum(m.setup_s for m in self.models.values())
+
+
 class ScenarioEvaluator:
     """Evaluate impact scenarios of one dam (that of ``base``) cheaply.
 
@@ -97,10 +141,9 @@ class ScenarioEvaluator:
                                                         strip_m=strip_m,
                                                         patch_y_m=patch_y_m)
         self.dam.static_state(base.water_level_m)
-        self._logs: dict = {}
-        self._steps_s = self._log_mesh_s = 0.0
+        self.logs = LogCache(self.dt, base.h_impact_m, self.dam.comm)
+        self._steps_s = 0.0
         self._split: dict = {}  # run_impact's coupled steps, log-only steps, convolution
-        self._log_meshes: dict = {}  # a log geometry's mesh, K and unit mass, every density
         self.setup_s = time.perf_counter() - t0
 
     def check(self, scenario: DamScenario) -> None:
@@ -136,21 +179,7 @@ class ScenarioEvaluator:
 
     def log_model(self, s: DamScenario) -> LogModel:
         """The cached LogModel of the scenario's log (made on first use)."""
-        key = log_key(s)
-        if key not in self._logs:
-            geometry = (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu)
-            mesh_key = geometry + (s.log_end,)
-            if mesh_key not in self._log_meshes:
-                t0 = time.perf_counter()
-                self._log_meshes[mesh_key] = LogMesh(
-                    *geometry, h_m=self.base.h_impact_m, comm=self.dam.comm, end=s.log_end,
-                    dim=s.dim)
-                self._log_mesh_s += time.perf_counter() - t0
-            self._logs[key] = LogModel(
-                s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
-                s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.base.h_impact_m, comm=self.dam.comm,
-                mesh=self._log_meshes[mesh_key], dim=s.dim)
-        return self._logs[key]
+        return self.logs.get(s)
 
     def evaluate(self, scenario: DamScenario) -> dict[str, float]:
         """The outputs of one scenario (plain floats): peak_force_N_per_m,
@@ -176,14 +205,17 @@ class ScenarioEvaluator:
         with the outputs they monitor, split into the steps with the dam stepped (the
         contact), those with the log alone, and the convolution after them."""
         return {"dam_setup_s": self.setup_s,
-                "log_setup_s": self._log_mesh_s + sum(m.setup_s for m in self._logs.values()),
+                "log_setup_s": self.logs.setup_s(),
                 "steps_s": self._steps_s, **self._split}
 
     def counts(self) -> dict:
         """{"factorizations": {"dam_stage1", "dam_stage2", "log"}, "back_substitutions":
         {same keys}}; "log" sums over the cached log models."""
         c = self.dam.counts()
-        logs = list(self._logs.values())
+        logs = list(self.logs.models.values())
         c["factorizations"]["log"] = sum(m.factorizations for m in logs)
         c["back_substitutions"]["log"] = sum(m.back_substitutions for m in logs)
+        restored = sum(getattr(m, "restorations", 0) for m in logs)
+        if restored:
+            c.setdefault("restorations", {})["log"] = restored
         return c

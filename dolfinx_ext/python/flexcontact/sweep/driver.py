@@ -37,16 +37,18 @@ def prepare(cfg: SweepConfig) -> dict:
             "checker": None}
     model = cfg.engine.get("model")
     if cfg.engine["evaluator"] == "reuse" and model is not None:
-        prep["model"] = dam_model(Path(model), base, dt, levels, face)
+        prep["model"] = dam_model(Path(model), base, dt, levels, face, scenarios)
         spec = prep["spec"] = replace(spec, model=str(model))
     if hasattr(cls, "check"):
         prep["checker"] = check_all(spec, points, scenarios)
     return prep
 
 
-def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = None) -> dict:
+def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = None,
+              scenarios=()) -> dict:
     """The dam model at ``path`` for this sweep: prepared there once (atomically) if absent,
-    else checked against the sweep's dam and time step (ConfigError naming what differs).
+    else checked against the sweep's dam and time step (ConfigError naming what differs);
+    it keeps the log models of ``scenarios`` (model_file.logs_of).
     Returns {"path", "prepared_this_run", "counts"}: the factorizations its preparation
     cost."""
     from ..dam import model_file
@@ -57,7 +59,9 @@ def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = 
             distinct = sorted(set(levels))
             manifest = model_file.prepare(base, dt, (min(levels), max(levels)), path,
                                           levels=distinct if len(distinct) <= 8 else None,
-                                          progress=lambda *a: None, **(face or {}))
+                                          progress=lambda *a: None,
+                                          logs=model_file.logs_of(base, scenarios),
+                                          **(face or {}))
         else:
             manifest = model_file.read_manifest(path)
             model_file.check_inputs(manifest, base, dt)
