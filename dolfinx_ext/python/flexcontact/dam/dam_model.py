@@ -97,6 +97,15 @@ def default_strip_m(base, water_levels_m, pitch_deg: float = 15.0,
     return float(z0), float(z1)
 
 
+def front_end_span_m(s, axis: int) -> tuple[float, float]:
+    """(lowest, highest) coordinate (m) along ``axis`` of the front end of scenario ``s``'s
+    log: the disc (a segment in 2D) of its radius about the axis's end."""
+    a = s.log_axis
+    c = float(s.log_centre[axis] + 0.5 * s.log_length_m * a[axis])
+    r = s.log_radius_m * float(np.sqrt(max(1.0 - a[axis] ** 2, 0.0)))
+    return c - r, c + r
+
+
 def face_region_m(base, scenarios, water_levels_m=None, margin_m: float = 1.0):
     """(strip_m, patch_y_m): the face strip's elevations and, in 3D, the patch's y range
     (None in 2D) that hold the base's default region and the front end of every one of
@@ -105,13 +114,11 @@ def face_region_m(base, scenarios, water_levels_m=None, margin_m: float = 1.0):
     z0, z1 = default_strip_m(base, (lo, hi))
     patch = default_patch_y_m(base)
     for s in scenarios:
-        a = s.log_axis
-        end = s.log_centre + 0.5 * s.log_length_m * a
-        rz = s.log_radius_m * np.sqrt(max(1.0 - a[-1] ** 2, 0.0)) + margin_m
-        z0, z1 = min(z0, end[-1] - rz), max(z1, end[-1] + rz)
+        lo, hi = front_end_span_m(s, s.dim - 1)
+        z0, z1 = min(z0, lo - margin_m), max(z1, hi + margin_m)
         if patch is not None:
-            ry = s.log_radius_m * np.sqrt(max(1.0 - a[1] ** 2, 0.0)) + margin_m
-            patch = (min(patch[0], end[1] - ry), max(patch[1], end[1] + ry))
+            lo, hi = front_end_span_m(s, 1)
+            patch = (min(patch[0], lo - margin_m), max(patch[1], hi + margin_m))
     z0 = max(z0, 0.5 * base.h_far_m)
     z1 = min(z1, base.dam_height_m - 0.5 * base.h_impact_m)
     if patch is not None:

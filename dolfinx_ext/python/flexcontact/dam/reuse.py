@@ -22,12 +22,11 @@ from __future__ import annotations
 import time
 from typing import Optional
 
-import numpy as np
 from mpi4py import MPI
 
 from .. import impact_setup as setup
 from .coupled_step import AFTER_CONTACT, expected_contact_s, run_impact
-from .dam_model import DamModel
+from .dam_model import DamModel, front_end_span_m
 from .log_model import LogMesh, LogModel
 from .scenario import DamScenario
 from .stage2 import sweep_time_step_s
@@ -155,26 +154,20 @@ class ScenarioEvaluator:
                              f"{(lo, hi)} the dam was built for (water_levels_m)")
         setup.check_resolution(self.dt, expected_contact_s(scenario, self.dam),
                                "2L/c of the log along the face normal")
-        a = scenario.log_axis
-        end = scenario.log_centre + 0.5 * scenario.log_length_m * a  # the end's centre
-
-        def reach(k):  # the end's disc (a segment in 2D) along axis k
-            return scenario.log_radius_m * np.sqrt(max(1.0 - a[k] ** 2, 0.0))
-
         z0, z1 = self.dam.strip_m
-        front, r = end[-1], reach(len(a) - 1)
-        if not (z0 <= front - r and front + r <= z1):
+        lo, hi = front_end_span_m(scenario, scenario.dim - 1)
+        if not (z0 <= lo and hi <= z1):
             raise InputError(
                 f"log_pitch_deg={scenario.log_pitch_deg!r}, water_level_m="
                 f"{scenario.water_level_m!r}: the log's front end (elevations "
-                f"{front - r:.3f}..{front + r:.3f} m) leaves the face strip "
+                f"{lo:.3f}..{hi:.3f} m) leaves the face strip "
                 f"{z0:.3f}..{z1:.3f} m of this dam (strip_m)")
         if self.dam.patch_y_m is not None:
-            (y0, y1), y, r = self.dam.patch_y_m, end[1], reach(1)
-            if not (y0 <= y - r and y + r <= y1):
+            (y0, y1), (lo, hi) = self.dam.patch_y_m, front_end_span_m(scenario, 1)
+            if not (y0 <= lo and hi <= y1):
                 raise InputError(
                     f"log_yaw_deg={scenario.log_yaw_deg!r}: the log's front end (y "
-                    f"{y - r:.3f}..{y + r:.3f} m) leaves the face patch {y0:.3f}..{y1:.3f} m "
+                    f"{lo:.3f}..{hi:.3f} m) leaves the face patch {y0:.3f}..{y1:.3f} m "
                     f"across this dam block (patch_y_m)")
 
     def log_model(self, s: DamScenario) -> LogModel:
