@@ -17,7 +17,7 @@ import pytest
 from mpi4py import MPI
 
 from flexcontact.dam import DamScenario
-from flexcontact.dam.coupled_step import run_impact
+from flexcontact.dam.coupled_step import run_impact, run_steps
 from flexcontact.dam.log_model import rotation
 from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
 from flexcontact.dam.stage1 import DamMesh, solve_stage1
@@ -57,7 +57,7 @@ def monolithic_on_the_same_meshes(evaluator, s) -> dict:
                                  (log.msh, log.cell_tags, log.facet_tags,
                                   lambda x: c[None, :] + x @ R.T)]))
     r1 = solve_stage1(s, mesh=mesh, comm=COMM)
-    n = run_impact_steps(evaluator, s)
+    n = run_steps(s, evaluator.dam)
     r2 = solve_stage2(s, r1, dt_s=evaluator.dt, duration_s=n * evaluator.dt, comm=COMM)
     m = r2.metrics
     heel = max(r1.section.sigma_heel_Pa, r2.section_extremes()["sigma_heel_max_Pa"])
@@ -69,11 +69,6 @@ def monolithic_on_the_same_meshes(evaluator, s) -> dict:
             "peak_contact_pressure_Pa": r2.peak_contact_pressure_Pa,
             "log_momentum_change_N_s_per_m": r2.log_momentum_change,
             "steps": r2.timings_s["steps_n"]}
-
-
-def run_impact_steps(evaluator, s) -> int:
-    from flexcontact.dam.coupled_step import run_steps
-    return run_steps(s, evaluator.dam)
 
 
 @pytest.mark.parametrize("k", range(len(SCENARIOS)))

@@ -249,16 +249,15 @@ def _log_arrays(base, dam, logs, arrays: dict) -> list:
     """Build the log model of each distinct log among ``logs`` at the dam's time step, put
     its arrays in ``arrays`` and return the manifest's entries."""
     from .reuse import LogCache, log_key
-    distinct = {}
-    for s in logs:
-        distinct.setdefault(log_key(s), s)
     cache = LogCache(dam.dt, base.h_impact_m, dam.comm)
     entries = []
-    for i, s in enumerate(distinct.values()):
+    for s in logs:
+        if log_key(s) in cache.models:
+            continue  # one entry per distinct log
         log = cache.get(s)
         if log.factor_kind != "dense":
             continue  # a large log is built on the spot when asked
-        p = f"log{i}_"
+        p = f"log{len(entries)}_"
         arrays.update(log.mesh.arrays(p))
         arrays.update(log.factor.arrays(p + "f_"))
         entries.append({"prefix": p, "scenario": s.as_dict()})
