@@ -178,6 +178,7 @@ def contact_phase(m: dict, increments: int, repeat: int) -> dict:
                                      "schur_s", "inverse_s", "ordering_s", "factor_entries",
                                      "factor_flops", "factor_memory_mb")})
     out["fstar_w_s"] = out["flexibility_s"] + out["delassus_s"]
+    out["delassus_routes"] = list(info.get("delassus_routes", []))
     # an increment is one back-substitution split around the contact solve when the factor
     # condenses and expands (serial Schur factor), two full ones otherwise
     out["split_increment"] = bool(info.get("condense", False))

@@ -205,7 +205,7 @@ def _case_table(cases: list[dict]) -> list[str]:
 
 def _split_table(cases: list[dict]) -> list[str]:
     out = ["| case | ordering plain / Schur | plain factor entries | Schur factor entries | "
-           "factorization with Schur s | Schur extraction s | dense inverse s | W s | "
+           "factorization with Schur s | Schur extraction s | Cholesky of the blocks s | W s (route per body) | "
            "set-up s | first increment s | (c) − 2(d) − local solve ms | linear solve s | "
            "local solver (iterations) | case wall / CPU s | load average |",
            "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---|"]
@@ -218,7 +218,8 @@ def _split_table(cases: list[dict]) -> list[str]:
             f"| {c['name']} | {lin['mumps_ordering']} / {con['mumps_ordering']} | "
             f"{lin['factor_entries'] / 1e6:.1f}M | {con['factor_entries'] / 1e6:.1f}M | "
             f"{_f(con['factorization_s'])} | {_f(con['schur_s'])} | {_f(con['inverse_s'])} | "
-            f"{_f(con['delassus_s'], 3)} | {_f(con['setup_s'])} | "
+            f"{_f(con['delassus_s'], 3)} ({', '.join(con.get('delassus_routes', [])) or '—'}) | "
+            f"{_f(con['setup_s'])} | "
             f"{_f(con['first_increment_s'])} | "
             f"{_f((c['increment_s'] - 2 * c['backsolve_s'] - c['contact_solve_s']) * 1e3, 1)} | "
             f"{_f(lin['solve_s'])} | "
@@ -256,9 +257,11 @@ def _why(rows: list[dict], cases: list[dict]) -> list[str]:
                 f"{con['factor_entries'] / 1e6:.1f}M entries) against the plain one's "
                 f"{lin['factorization_s']:.1f} s ({lin['mumps_ordering']}, "
                 f"{lin['factor_entries'] / 1e6:.1f}M entries); on top of it the Schur "
-                f"complement's extraction {con['schur_s']:.1f} s, its dense inverse "
-                f"{con['inverse_s']:.1f} s (n_c = {con['contact_dofs']:,}) and W "
-                f"{con['delassus_s']:.2f} s.")
+                f"complement's extraction {con['schur_s']:.1f} s, the Cholesky factors of its "
+                f"blocks {con['inverse_s']:.1f} s (n_c = {con['contact_dofs']:,}) and W "
+                f"{con['delassus_s']:.2f} s (per body: "
+                f"{', '.join(con.get('delassus_routes', [])) or '—'}; the inverse route's "
+                f"dpotri is part of W).")
         elif r["target"].startswith("(c)"):
             split = c.get("split_increment", False)
             solves = 1 if split else 2
@@ -319,7 +322,8 @@ def markdown(res: dict) -> str:
         "(a) one plain MUMPS factorization of K (analysis with flexcontact's ordering, "
         "`ordering=\"auto\"`, and numerical factorization, no Schur complement); (b) F* "
         "(the factorization with the Schur complement on the contact DOFs, its extraction "
-        "and dense inverse) and W = B F* Bᵀ; (c) one load increment after set-up (median of "
+        "and the Cholesky factor of each body's block) and W = B F* Bᵀ (per body by the "
+        "cheaper of the inverse and the triangular route, docs/architecture.md §7); (c) one load increment after set-up (median of "
         "increments 2–4 of a ramp of the approach to a²/R, no output written); (d) one "
         "back-substitution with the stored factor (median of one before each increment and 5 "
         "after them); local solve: the kernel's "

@@ -8,6 +8,7 @@
 
 #include "bindings.h"
 
+#include <flexcontact/block_flexibility.hpp>
 #include <flexcontact/condensed.hpp>
 #include <flexcontact/pairs.hpp>
 
@@ -70,6 +71,38 @@ void flexcontact::bind_condensed(py::module& m)
         "masters (m x j), weights (m x j), normals (m x d), offsets (m, normal distance of the "
         "master surface from the master point [m]; None: 0)");
 
+  py::class_<BlockFlexibility, std::shared_ptr<BlockFlexibility>>(
+      m, "BlockFlexibility",
+      "F* held by body as each block's Cholesky factor S_b = L_b L_b^T (F*_b = S_b^-1): W = "
+      "B F* B^T is formed per body by the cheaper of the inverse route (2/3 n^3) and the "
+      "triangular one (n^2 r + n r^2), n the body's contact DOFs and r the rows of B on them")
+      .def(py::init<Eigen::Index, std::vector<std::vector<int>>, std::vector<Matrix>>(),
+           py::arg("n"), py::arg("blocks"), py::arg("L"),
+           "n contact DOFs; blocks: the positions of each block's DOFs; L: each block's lower "
+           "Cholesky factor (a DOF in no block has zero flexibility)")
+      .def(
+          "extended",
+          [](const BlockFlexibility& F, Eigen::Index n)
+          {
+            BlockFlexibility G = F;
+            G.extend(n);
+            return G;
+          },
+          py::arg("n"), "A copy with n >= rows DOFs, the new ones without flexibility")
+      .def("apply", &BlockFlexibility::apply, py::arg("v"), "F* v")
+      .def("delassus", &BlockFlexibility::delassus, py::arg("B"),
+           "W = B F* B^T by the cheaper route per block (routes)")
+      .def("dense", &BlockFlexibility::dense, "F* as a dense matrix")
+      .def_property_readonly("rows", &BlockFlexibility::rows)
+      .def_property_readonly("block_sizes", &BlockFlexibility::block_sizes)
+      .def_property_readonly("routes", &BlockFlexibility::routes,
+                             "Per block, the route of the last delassus: inverse, "
+                             "triangular, none (no row of B on it) or dense")
+      .def_property_readonly("flops_taken", &BlockFlexibility::flops_taken,
+                             "Flop estimate of the last delassus, routes as taken")
+      .def_property_readonly("flops_inverse", &BlockFlexibility::flops_inverse,
+                             "Flop estimate of the last delassus, all by the inverse route");
+
   py::class_<CondensedContact>(
       m, "CondensedContact",
       "The condensed contact problem x = W lambda + q: pairs, B, x0, W = B F* B^T and the "
@@ -85,6 +118,17 @@ void flexcontact::bind_condensed(py::module& m)
            py::arg("constrained") = py::none(), py::arg("options") = SolverOptions(),
            "F (n_c x n_c) flexibility; X (n_nodes x dim) contact node coordinates; mu per "
            "pair; constrained: n_c flags of Dirichlet-held contact DOFs (None: none)")
+      .def(py::init(
+               [](int dim, const BlockFlexibility& F, Matrix X, std::vector<ContactPair> pairs,
+                  Vector mu, const std::optional<BoolArray>& constrained,
+                  const SolverOptions& options)
+               {
+                 return CondensedContact(dim, F, std::move(X), std::move(pairs), std::move(mu),
+                                         flags(constrained), options);
+               }),
+           py::arg("dim"), py::arg("F"), py::arg("X"), py::arg("pairs"), py::arg("mu"),
+           py::arg("constrained") = py::none(), py::arg("options") = SolverOptions(),
+           "As above with F* a BlockFlexibility (copied): W per body by the cheaper route")
       .def(
           "step",
           [convergence_error](CondensedContact& c, const Vector& up_c,
@@ -145,6 +189,17 @@ void flexcontact::bind_condensed(py::module& m)
       .def_property_readonly("W", [](const CondensedContact& c) { return c.W(); })
       .def_property_readonly("F", [](const CondensedContact& c) { return c.flexibility(); },
                              "F* with the constrained DOFs' rows and columns zeroed")
+      .def_property_readonly("delassus_routes",
+                             [](const CondensedContact& c) { return c.delassus_routes(); },
+                             "Per body, how the last W was formed: inverse, triangular, none "
+                             "or dense (F* given dense)")
+      .def_property_readonly("delassus_flops",
+                             [](const CondensedContact& c)
+                             {
+                               const BlockFlexibility& F = c.block_flexibility();
+                               return py::make_tuple(F.flops_taken(), F.flops_inverse());
+                             },
+                             "Flop estimates of the last W: (as taken, all by inverse)")
       .def_property_readonly("mu", [](const CondensedContact& c) { return c.mu(); })
       .def_property_readonly("last_q", [](const CondensedContact& c) { return c.last_q(); },
                              "q = B up_c + x0 of the last step call, also a failed one")

@@ -252,13 +252,13 @@ void bind_flexibility(py::module& m)
   m.def(
       "flexibility",
       [](Mat K, py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> contact_dofs,
-         const std::string& method, const std::string& ordering, bool per_body)
+         const std::string& method, const std::string& ordering, bool per_body, bool factors)
       {
         std::span<const std::int64_t> dofs(contact_dofs.data(), contact_dofs.size());
         Flexibility r;
         {
           py::gil_scoped_release release;
-          r = flexibility(K, dofs, method, ordering, per_body);
+          r = flexibility(K, dofs, method, ordering, per_body, factors);
         }
         py::dict info = flexibility_info(r);
         py::object factor;
@@ -270,11 +270,12 @@ void bind_flexibility(py::module& m)
         }
         else
           factor = factor_object(r, dofs, info);
-        py::array_t<double> F = py::cast(r.F);
+        info["form"] = r.factors ? "factors" : "dense";
+        py::object F = r.factors ? py::cast(r.factors) : py::cast(r.F);
         return py::make_tuple(F, factor, info);
       },
       py::arg("K"), py::arg("contact_dofs"), py::arg("method") = "schur",
-      py::arg("ordering") = "auto", py::arg("per_body") = true,
+      py::arg("ordering") = "auto", py::arg("per_body") = true, py::arg("factors") = false,
       R"(Flexibility F* = (K^-1)_cc on the contact DOFs from one MUMPS Cholesky factorization.
 
 Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); contact_dofs
@@ -293,6 +294,9 @@ per_body (default True): the contact DOFs that K's graph connects form a block (
 touching contact); F* is block-diagonal by them and only the blocks are computed ("schur":
 each block of K*_cc inverted on its own; "inverse_entries": only entries within blocks asked
 of MUMPS). False: one block of all contact DOFs (the same F* up to rounding).
+factors (default False; "schur" only): F* kept as each block's Cholesky factor, returned as a
+BlockFlexibility on rank 0 (W is then formed per body by the cheaper route, with no dense
+inverse where the triangular route wins); info["form"] is "factors" or "dense".
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
 factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; with
 "schur" a SchurFactor on one process, a DistributedSchur on several (factor.has_condense:

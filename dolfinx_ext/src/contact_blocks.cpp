@@ -21,7 +21,6 @@ using namespace flexcontact;
 extern "C"
 {
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
-void dpotri_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 void dpocon_(const char* uplo, const int* n, const double* a, const int* lda,
              const double* anorm, double* rcond, double* work, int* iwork, int* info);
 }
@@ -187,13 +186,13 @@ std::vector<std::vector<int>> flexcontact::block_members(const std::vector<int>&
   return blocks;
 }
 
-Eigen::MatrixXd flexcontact::blockwise_inverse(const double* s, std::size_t lda,
-                                               const std::vector<std::vector<int>>& blocks)
+BlockFlexibility flexcontact::blockwise_cholesky(const double* s, std::size_t lda,
+                                                const std::vector<std::vector<int>>& blocks)
 {
   std::size_t n = 0;
   for (const auto& b : blocks)
     n += b.size();
-  Eigen::MatrixXd F = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::MatrixXd> factors;
   for (std::size_t b = 0; b < blocks.size(); ++b)
   {
     const std::vector<int>& idx = blocks[b];
@@ -222,12 +221,14 @@ Eigen::MatrixXd flexcontact::blockwise_inverse(const double* s, std::size_t lda,
     }
     if (info != 0 or !(rcond > 1e3 * std::numeric_limits<double>::epsilon()))
       throw SingularStiffnessError(singular_block(b, blocks.size(), nb, info == 0 ? rcond : 0.0));
-    dpotri_("L", &nb, A.data(), &nb, &info);
-    if (info != 0)
-      throw SingularStiffnessError(singular_block(b, blocks.size(), nb, 0.0));
-    for (int j = 0; j < nb; ++j)
-      for (int i = j; i < nb; ++i)
-        F(idx[i], idx[j]) = F(idx[j], idx[i]) = A(i, j);
+    A.triangularView<Eigen::StrictlyUpper>().setZero();
+    factors.push_back(std::move(A));
   }
-  return F;
+  return BlockFlexibility(static_cast<Eigen::Index>(n), blocks, std::move(factors));
+}
+
+Eigen::MatrixXd flexcontact::blockwise_inverse(const double* s, std::size_t lda,
+                                               const std::vector<std::vector<int>>& blocks)
+{
+  return blockwise_cholesky(s, lda, blocks).dense();
 }

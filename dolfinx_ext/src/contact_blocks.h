@@ -12,6 +12,8 @@
 /// joins them. Structural (not numerical) non-zeros are used, so a block is never split
 /// where K couples, and Dirichlet rows (zeroed but kept in DOLFINx's pattern) change nothing.
 
+#include "flexcontact/block_flexibility.hpp"
+
 #include <Eigen/Dense>
 #include <petscmat.h>
 #include <vector>
@@ -28,12 +30,17 @@ std::vector<int> contact_blocks(Mat K, const std::vector<PetscInt>& dofs);
 /// @brief Positions (into the contact DOF list) of each block's DOFs, blocks in label order.
 std::vector<std::vector<int>> block_members(const std::vector<int>& labels);
 
-/// @brief F = S⁻¹ for a symmetric positive definite S that is block-diagonal by `blocks`:
-/// each block symmetrised, factored by LAPACK's Cholesky (dpotrf) and inverted (dpotri);
-/// entries between blocks are zero. S is read column-major from `s` with leading dimension
-/// `lda` (n×n, n the total of the blocks' sizes); entries between blocks are not read.
+/// @brief F = S⁻¹ for a symmetric positive definite S that is block-diagonal by `blocks`,
+/// held as each block's Cholesky factor: the block symmetrised and factored by LAPACK
+/// (dpotrf). S is read column-major from `s` with leading dimension `lda` (n×n, n the total
+/// of the blocks' sizes); entries between blocks are not read.
 /// @throws SingularStiffnessError naming the block if one is not positive definite or its
 /// reciprocal condition number (dpocon, 1-norm) is below 1e3·ε
+BlockFlexibility blockwise_cholesky(const double* s, std::size_t lda,
+                                    const std::vector<std::vector<int>>& blocks);
+
+/// @brief F = S⁻¹ as a dense matrix (blockwise_cholesky, each block inverted by dpotri);
+/// entries between blocks are zero.
 Eigen::MatrixXd blockwise_inverse(const double* s, std::size_t lda,
                                   const std::vector<std::vector<int>>& blocks);
 } // namespace flexcontact

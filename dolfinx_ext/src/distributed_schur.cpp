@@ -177,6 +177,17 @@ void DistributedSchur::set_flexibility(const Eigen::MatrixXd& F)
   schur_is_inverse_ = true;
 }
 
+void DistributedSchur::set_flexibility(std::shared_ptr<const BlockFlexibility> F)
+{
+  if (rank_ == 0)
+  {
+    if (!F or F->rows() != n_c_)
+      throw std::invalid_argument("F* has the wrong size");
+    factors_ = std::move(F);
+  }
+  schur_is_inverse_ = true;
+}
+
 void DistributedSchur::scatter_back(const double* host, Vec x)
 {
   PetscErrorScope err;
@@ -412,7 +423,10 @@ void DistributedSchur::solve(Vec b, Vec x)
     throw std::logic_error("DistributedSchur::solve before set_flexibility");
   std::vector<double> rb = condense(b);
   std::vector<double> uc(rb.size());
-  if (rank_ == 0 and n_c_ > 0)
+  if (rank_ == 0 and n_c_ > 0 and factors_)
+    Eigen::Map<Eigen::VectorXd>(uc.data(), n_c_)
+        = factors_->apply(Eigen::Map<const Eigen::VectorXd>(rb.data(), n_c_));
+  else if (rank_ == 0 and n_c_ > 0)
   {
     Eigen::Map<const Eigen::MatrixXd> F(schur_.data(), n_c_, n_c_);
     Eigen::Map<Eigen::VectorXd>(uc.data(), n_c_)
@@ -423,7 +437,8 @@ void DistributedSchur::solve(Vec b, Vec x)
 
 Flexibility flexcontact::distributed_flexibility(Mat K, const std::vector<PetscInt>& dofs,
                                                 const std::string& ordering,
-                                                const std::vector<std::vector<int>>& blocks)
+                                                const std::vector<std::vector<int>>& blocks,
+                                                bool factors)
 {
   MPI_Comm comm = PetscObjectComm(reinterpret_cast<PetscObject>(K));
   int rank = 0;
@@ -459,7 +474,11 @@ Flexibility flexcontact::distributed_flexibility(Mat K, const std::vector<PetscI
   {
     try
     {
-      out.F = blockwise_inverse(S, dofs.size(), blocks);
+      BlockFlexibility Fs = blockwise_cholesky(S, dofs.size(), blocks);
+      if (factors)
+        out.factors = std::make_shared<BlockFlexibility>(std::move(Fs));
+      else
+        out.F = Fs.dense();
     }
     catch (const SingularStiffnessError& e)
     {
@@ -469,7 +488,10 @@ Flexibility flexcontact::distributed_flexibility(Mat K, const std::vector<PetscI
   }
   throw_collective_if(comm, singular, what,
                       [](const std::string& w) { throw SingularStiffnessError(w); });
-  f->set_flexibility(out.F);
+  if (out.factors)
+    f->set_flexibility(std::shared_ptr<const BlockFlexibility>(out.factors));
+  else
+    f->set_flexibility(out.F);
   out.inverse_s = MPI_Wtime() - t1 - out.schur_s;
   out.distributed = std::move(f);
   return out;

@@ -21,8 +21,11 @@
 /// solution scattered back from it) stays selectable (set_distributed_io) and is taken
 /// automatically if MUMPS refuses the distributed one (its INFOG(1) in io_refusal()).
 
+#include "flexcontact/block_flexibility.hpp"
+
 #include <Eigen/Dense>
 #include <dmumps_c.h>
+#include <memory>
 #include <mpi.h>
 #include <petscmat.h>
 
@@ -81,6 +84,9 @@ public:
   /// @brief Rank 0: keep F* (n_c × n_c) for the full solves (it replaces K*_cc).
   void set_flexibility(const Eigen::MatrixXd& F);
 
+  /// @brief Rank 0: F* by block, shared, for the full solves.
+  void set_flexibility(std::shared_ptr<const BlockFlexibility> F);
+
   /// @brief x = K⁻¹ b (collective; b and x laid out as K's rows).
   void solve(Vec b, Vec x);
 
@@ -121,6 +127,7 @@ private:
   std::vector<int> irn_, jcn_, listvar_, perm_in_;
   std::vector<double> a_, schur_, redrhs_, rhs_, condensed_rhs_;
   bool schur_is_inverse_ = false;
+  std::shared_ptr<const BlockFlexibility> factors_; ///< F* by block, when kept so
   bool condensed_ = false;
   VecScatter to_zero_ = nullptr; ///< K's row layout → all on rank 0
   Vec host_ = nullptr;           ///< the N values on rank 0 (0 elsewhere)
@@ -151,5 +158,6 @@ struct Flexibility;
 /// taken); "metis" orders the nodal graph gathered on rank 0. Collective.
 Flexibility distributed_flexibility(Mat K, const std::vector<PetscInt>& dofs,
                                     const std::string& ordering,
-                                    const std::vector<std::vector<int>>& blocks);
+                                    const std::vector<std::vector<int>>& blocks,
+                                    bool factors);
 } // namespace flexcontact

@@ -231,14 +231,15 @@ void complete_symmetric(PetscScalar* a, PetscInt n, PetscInt lda)
 }
 
 /// @brief F* = (K*_cc)⁻¹ on rank 0 from the Schur complement of the factor, block by block
-/// (`blocks`: rank 0's positions of each block's contact DOFs).
+/// (`blocks`: rank 0's positions of each block's contact DOFs), as each block's Cholesky
+/// factor.
 ///
 /// The Schur complement is read where MUMPS wrote it, in the factor (no copy: PETSc's
 /// MatFactorCreateSchurComplement copies it, 0.5 s at 4,000 contact DOFs); its missing
 /// triangle is filled in, which leaves it the same matrix for PETSc's later full solves.
-Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
-                                 int n_c, const std::vector<std::vector<int>>& blocks,
-                                 double& schur_s, double& inverse_s)
+BlockFlexibility cholesky_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
+                                   int n_c, const std::vector<std::vector<int>>& blocks,
+                                   double& schur_s)
 {
   double t0 = MPI_Wtime();
   Mat S = nullptr; // borrowed from F
@@ -260,7 +261,7 @@ Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, 
   double t1 = MPI_Wtime();
   schur_s = t1 - t0;
 
-  Eigen::MatrixXd Fs;
+  BlockFlexibility Fs;
   bool singular = false;
   std::string what;
   if (rank == 0)
@@ -275,7 +276,7 @@ Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, 
     err.check(MatDenseGetArrayRead(S, &a), "MatDenseGetArrayRead");
     try
     {
-      Fs = blockwise_inverse(a, static_cast<std::size_t>(lda), blocks);
+      Fs = blockwise_cholesky(a, static_cast<std::size_t>(lda), blocks);
     }
     catch (const SingularStiffnessError& e)
     {
@@ -287,7 +288,6 @@ Eigen::MatrixXd inverse_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, 
   err.check(MatFactorRestoreSchurComplement(F, &S, status), "MatFactorRestoreSchurComplement");
   throw_collective_if(comm, singular, what,
                       [](const std::string& w) { throw SingularStiffnessError(w); });
-  inverse_s = MPI_Wtime() - t1;
   return Fs;
 }
 
@@ -468,7 +468,7 @@ Eigen::MatrixXd selected_inverse(PetscErrorScope& err, MPI_Comm comm, int rank, 
 
 Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
                                      const std::string& method, const std::string& ordering,
-                                     bool per_body)
+                                     bool per_body, bool factors)
 {
   if (method != "schur" and method != "inverse_entries" and method != "matmatsolve")
     throw std::invalid_argument("unknown flexibility method '" + method
@@ -539,7 +539,7 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
 
   if (direct)
   {
-    Flexibility d = distributed_flexibility(K, dofs, out.ordering, blocks);
+    Flexibility d = distributed_flexibility(K, dofs, out.ordering, blocks, factors);
     d.ordering_auto = out.ordering_auto;
     d.n_blocks = out.n_blocks;
     d.block_sizes = std::move(out.block_sizes);
@@ -563,7 +563,13 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     F.m = factorize(err, K, &root_dofs, out.ordering, out);
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
-    out.F = inverse_of_schur(err, comm, rank, F.m, n_c, blocks, out.schur_s, out.inverse_s);
+    BlockFlexibility Fs = cholesky_of_schur(err, comm, rank, F.m, n_c, blocks, out.schur_s);
+    double t1 = MPI_Wtime();
+    if (rank == 0 and factors)
+      out.factors = std::make_shared<BlockFlexibility>(std::move(Fs));
+    else if (rank == 0)
+      out.F = Fs.dense();
+    out.inverse_s = MPI_Wtime() - t1;
     out.factor = F.release();
   }
   else

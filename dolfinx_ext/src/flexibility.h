@@ -5,6 +5,8 @@
 /// @brief The flexibility F* = (K⁻¹)_cc on the contact DOFs from one MUMPS factorization
 /// (the seed's eqs. 4 and 6), without ever inverting K.
 
+#include "flexcontact/block_flexibility.hpp"
+
 #include <Eigen/Dense>
 #include <cstdint>
 #include <memory>
@@ -41,6 +43,9 @@ struct Flexibility
   /// (K⁻¹)_cc, n_c×n_c, rows/columns in the order of the given contact DOFs, symmetrised;
   /// on rank 0 only (0×0 elsewhere).
   Eigen::MatrixXd F;
+  /// F* as each block's Cholesky factor (rank 0, "schur" with `factors` asked; F is then
+  /// empty). The directly driven factor on several ranks shares it for its full solves.
+  std::shared_ptr<BlockFlexibility> factors;
   /// MUMPS Cholesky factor of K; MatSolve(factor, b, x) gives x = K⁻¹ b. The caller owns
   /// one reference (MatDestroy).
   Mat factor = nullptr;
@@ -109,12 +114,16 @@ struct Flexibility
 ///   ranks "schur" takes it too (METIS on the nodal graph gathered on rank 0), the other
 ///   methods MUMPS's automatic choice
 /// @param per_body condense each block (body) on its own (default); false: one block
+/// @param factors "schur" only: keep F* as each block's Cholesky factor
+///   (Flexibility::factors, F then empty), so that W is formed by the cheaper route per
+///   body (block_flexibility.hpp); the other methods give F* dense regardless
 /// @throws std::invalid_argument on an unknown method or contact DOFs out of range/repeated
 /// @throws SingularStiffnessError if K is singular (null pivots or singular K*_cc)
 /// @throws MumpsError on a MUMPS failure, PetscError on a PETSc failure
 Flexibility flexibility(Mat K, std::span<const std::int64_t> contact_dofs,
                         const std::string& method = "schur",
-                        const std::string& ordering = "auto", bool per_body = true);
+                        const std::string& ordering = "auto", bool per_body = true,
+                        bool factors = false);
 
 /// @brief MUMPS's analysis only (serial): what the factorization of K with `ordering` and a
 /// Schur complement on `contact_dofs` (none if empty) would cost, without factorizing. In the

@@ -27,19 +27,31 @@ const std::string who = "flexcontact: CondensedContact: ";
 CondensedContact::CondensedContact(int dim, Matrix Fstar, Matrix X,
                                    std::vector<ContactPair> pairs, Vector mu,
                                    std::vector<bool> constrained, SolverOptions options)
+    : CondensedContact(dim, BlockFlexibility(std::move(Fstar)), std::move(X), std::move(pairs),
+                       std::move(mu), std::move(constrained), std::move(options))
+{
+}
+
+CondensedContact::CondensedContact(int dim, BlockFlexibility Fstar, Matrix X,
+                                   std::vector<ContactPair> pairs, Vector mu,
+                                   std::vector<bool> constrained, SolverOptions options)
     : dim_(detail::checked_dim(dim, who)), F_(std::move(Fstar)), X_(std::move(X)),
       pairs_(std::move(pairs)), mu_(std::move(mu)), constrained_(std::move(constrained)),
       options_(std::move(options)), solver_(dim_, Matrix(), Vector(), options_)
 {
   detail::check_coordinates(X_, dim_, who);
   const Eigen::Index n_c = X_.rows() * dim_;
-  detail::check_flexibility(F_, n_c, "F*", who);
+  if (F_.factored())
+    detail::check_flexibility_rows(F_.rows(), n_c, "F*", who);
+  else
+    detail::check_flexibility(F_.given(), n_c, "F*", who);
   detail::check_mu_count(mu_, pairs_.size(), who);
-  zero_constrained(F_, constrained_, who);
+  check_constrained(constrained_, n_c, who);
+  F_.set_constrained(constrained_);
   // gap_operator and initial_gap check the pairs against the node count and dimension.
   B_ = gap_operator(dim_, static_cast<int>(X_.rows()), pairs_);
   x0_ = initial_gap(pairs_, X_);
-  solver_ = IncrementalSolver(dim_, delassus(B_, F_), mu_, options_);
+  solver_ = IncrementalSolver(dim_, F_.delassus(B_), mu_, options_);
   solver_.set_initial_gap(x0_);
   R_ = Matrix::Zero(n_c, 0);
   crush_node_ = Vector::Zero(X_.rows());
@@ -71,9 +83,10 @@ void CondensedContact::set_rigid_modes(Matrix Rc)
 void CondensedContact::set_flexibility(Matrix Fstar)
 {
   detail::check_flexibility(Fstar, F_.rows(), "F*", who);
-  zero_constrained(Fstar, constrained_, who);
-  solver_.set_delassus(delassus(B_, Fstar));
-  F_ = std::move(Fstar);
+  BlockFlexibility F(std::move(Fstar));
+  F.set_constrained(constrained_);
+  solver_.set_delassus(F.delassus(B_));
+  F_ = std::move(F);
 }
 
 void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
@@ -83,7 +96,7 @@ void CondensedContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vect
   // Built aside first, so that bad pairs leave the object as it was.
   auto B = gap_operator(dim_, static_cast<int>(X_.rows()), pairs);
   Vector x0 = initial_gap(pairs, X_);
-  IncrementalSolver solver(dim_, delassus(B, F_), mu, options_);
+  IncrementalSolver solver(dim_, F_.delassus(B), mu, options_);
   solver.set_initial_gap(u_c_.size() ? Vector(B * u_c_ + x0) : x0);
   if (!solver_.states().empty())
   {
@@ -147,8 +160,8 @@ CondensedStep CondensedContact::step_condensed(const Eigen::Ref<const Vector>& b
   if (b_c.size() != F_.rows())
     throw std::invalid_argument(who + "step_condensed: b_c has " + std::to_string(b_c.size())
                                 + " entries, expected n_c = " + std::to_string(F_.rows()));
-  // F_ has the constrained rows and columns zeroed; K's identity rows give them F* = 1.
-  Vector up_c = F_ * b_c;
+  // F_ is zero on the constrained rows and columns; K's identity rows give them F* = 1.
+  Vector up_c = F_.apply(b_c);
   for (std::size_t i = 0; i < constrained_.size(); ++i)
     if (constrained_[i])
       up_c[static_cast<Eigen::Index>(i)] = b_c[static_cast<Eigen::Index>(i)];
@@ -191,7 +204,7 @@ CondensedStep CondensedContact::step(const Eigen::Ref<const Vector>& up_c,
   }
 
   detail::summarize_step(r, pairs_, dim_, previous, B_, constrained_);
-  r.solution_c = up_c + F_ * r.reaction;
+  r.solution_c = up_c + F_.apply(r.reaction);
   // Kept for re-pairing: the gap of new pairs at this displacement is their slip origin.
   u_c_ = r.solution_c;
   if (R_.cols())

@@ -48,6 +48,15 @@ inline void check_flexibility(const Matrix& F, Eigen::Index n_c, const char* nam
     throw std::invalid_argument(who + name + " is not finite");
 }
 
+/// @brief Throws unless a flexibility held by block (`name`) has n_c rows.
+inline void check_flexibility_rows(Eigen::Index rows, Eigen::Index n_c, const char* name,
+                                   const std::string& who)
+{
+  if (rows != n_c)
+    throw std::invalid_argument(who + name + " has " + std::to_string(rows) + " rows, expected "
+                                + std::to_string(n_c) + " (contact nodes × dim)");
+}
+
 /// @brief Throws unless there is one friction coefficient per pair.
 inline void check_mu_count(const Vector& mu, std::size_t pairs, const std::string& who)
 {

@@ -62,7 +62,10 @@ class Condensation:
                                       pairs.m if root else None, dim)
         self.timings = {}
         t0 = time.perf_counter()
-        F, self.factor, info = _cpp.flexibility(K, self.dofs, method, ordering)
+        # The static problem holds F* by body as Cholesky factors, so that W takes the cheaper
+        # route per body (docs/architecture.md §7); a caller's own kernel object takes it dense.
+        F, self.factor, info = _cpp.flexibility(K, self.dofs, method, ordering,
+                                                factors=kernel is None)
         self.timings["flexibility_s"] = time.perf_counter() - t0
         self.flex_info = dict(info)
         self.factorizations = 1
@@ -72,8 +75,11 @@ class Condensation:
         self._cached = None
         if root:
             nv = self.n_virtual_dofs
-            if nv:
+            if nv and isinstance(F, _cpp.BlockFlexibility):
+                F = F.extended(F.rows + nv)
+            elif nv:
                 F = np.pad(np.asarray(F), ((0, nv), (0, nv)))
+            if nv:
                 constrained = np.concatenate([constrained, np.ones(nv, bool)])
             t0 = time.perf_counter()
             build = kernel if kernel is not None else _cpp.CondensedContact
@@ -82,6 +88,7 @@ class Condensation:
             if caps is not None:
                 self.contact.set_crushing(caps)
             self.timings["delassus_s"] = time.perf_counter() - t0
+            self._record_routes()
 
     def _contact_scatter(self, K: PETSc.Mat, pairs, dim: int) -> None:
         """The contact DOFs (rank 0's list, empty elsewhere), the number of virtual ones
@@ -139,6 +146,16 @@ class Condensation:
         caps = pair_caps(pairs)
         self.contact.set_pairs(kernel_pairs(pairs), mu, np.zeros(0) if caps is None else caps)
         self._cached = None
+        self._record_routes()
+
+    def _record_routes(self) -> None:
+        """info's account of how W was last formed, per body (rank 0)."""
+        routes = getattr(self.contact, "delassus_routes", None)
+        if routes is not None:
+            self.flex_info["delassus_routes"] = list(routes)
+            taken, inverse = self.contact.delassus_flops
+            self.flex_info["delassus_flops"] = float(taken)
+            self.flex_info["delassus_flops_by_inverse"] = float(inverse)
 
     def refactor(self, A: PETSc.Mat, method: str, ordering: str, dt_s: float,
                  where: str) -> None:

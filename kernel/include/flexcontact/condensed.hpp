@@ -9,11 +9,13 @@
 /// the states, the contact reaction r_c = Bᵀ λ and the totals come out. Contact DOFs are
 /// node-major (contact node a owns DOFs a·d + c), as in pairs.hpp.
 
+#include "flexcontact/block_flexibility.hpp"
 #include "flexcontact/increment.hpp"
 #include "flexcontact/pairs.hpp"
 #include "flexcontact/problem.hpp"
 
 #include <Eigen/Sparse>
+#include <string>
 #include <vector>
 
 namespace flexcontact
@@ -60,6 +62,12 @@ public:
   /// @throws std::invalid_argument naming the argument whose size or value is wrong
   CondensedContact(int dim, Matrix Fstar, Matrix X, std::vector<ContactPair> pairs, Vector mu,
                    std::vector<bool> constrained = {}, SolverOptions options = {});
+
+  /// @brief As above, with F* held by body as Cholesky factors (block_flexibility.hpp): W is
+  /// formed per body by the cheaper of the inverse and the triangular route
+  /// (delassus_routes()).
+  CondensedContact(int dim, BlockFlexibility Fstar, Matrix X, std::vector<ContactPair> pairs,
+                   Vector mu, std::vector<bool> constrained = {}, SolverOptions options = {});
 
   /// @brief Solve one increment from the contact-DOF values of u_p = K⁻¹ p (total load).
   /// @throws std::invalid_argument if up_c has the wrong size or is not finite
@@ -129,7 +137,11 @@ public:
   const Eigen::SparseMatrix<double>& B() const { return B_; } ///< m·d × n_c
   const Vector& x0() const { return x0_; }                   ///< initial gap, m·d
   const Matrix& W() const { return solver_.W(); }            ///< B F* Bᵀ, m·d × m·d
-  const Matrix& flexibility() const { return F_; }           ///< F*, constrained DOFs zeroed
+  Matrix flexibility() const { return F_.dense(); }          ///< F*, constrained DOFs zeroed
+  /// @brief Per body, how the last W was formed: "inverse", "triangular", "none" (no pair
+  /// touches it) or "dense" (F* given dense).
+  const std::vector<std::string>& delassus_routes() const { return F_.routes(); }
+  const BlockFlexibility& block_flexibility() const { return F_; }
   const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
   const Vector& mu() const { return mu_; }
   const IncrementalSolver& solver() const { return solver_; }
@@ -142,7 +154,7 @@ private:
   std::string held_and_penetrating(const Vector& q) const;
 
   int dim_;
-  Matrix F_;
+  BlockFlexibility F_;
   Matrix X_;
   std::vector<ContactPair> pairs_;
   Vector mu_;
