@@ -76,6 +76,7 @@ void flexcontact::bind_condensed(py::module& m)
       "F* held by body as each block's Cholesky factor S_b = L_b L_b^T (F*_b = S_b^-1): W = "
       "B F* B^T is formed per body by the cheaper of the inverse route (2/3 n^3) and the "
       "triangular one (n^2 r + n r^2), n the body's contact DOFs and r the rows of B on them")
+      .def(py::init<Matrix>(), py::arg("F"), "F* given dense (one block, its inverse known)")
       .def(py::init<Eigen::Index, std::vector<std::vector<int>>, std::vector<Matrix>>(),
            py::arg("n"), py::arg("blocks"), py::arg("L"),
            "n contact DOFs; blocks: the positions of each block's DOFs; L: each block's lower "
