@@ -62,7 +62,8 @@ struct Flexibility
   double factorization_s = 0;    ///< analysis + numerical factorization (all factorizations)
   double schur_s = 0;            ///< extracting K*_cc (schur), the selected-inverse solve
                                  ///< (inverse_entries) or the multi-RHS solve (matmatsolve)
-  double inverse_s = 0;          ///< dense Cholesky inversion of K*_cc (schur only)
+  double inverse_s = 0;          ///< the Cholesky factor of each block of K*_cc, and its
+                                 ///< dense inverse unless kept as factors (schur only)
   std::string ordering;          ///< ordering requested of MUMPS, "auto" resolved ("mumps" on
                                  ///< several ranks but for "schur")
   std::string mumps_ordering;    ///< ordering MUMPS used, from INFOG(7) ("metis" for ours)
