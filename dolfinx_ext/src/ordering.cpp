@@ -56,19 +56,52 @@ void nodal_graph(Mat K, PetscInt bs, std::vector<idx_t>& xadj, std::vector<idx_t
             "MatRestoreRowIJ");
 }
 /// @brief Pivot position (1-based, MUMPS's PERM_IN) of each of the N rows from METIS nested
-/// dissection of the nodal graph (xadj, adj; bs rows per node), the `last` rows moved to the
-/// end in their given order.
+/// dissection of the nodal graph (xadj, adj; bs rows per node) without the nodes of the
+/// `last` rows, which come at the end in their given order.
 std::vector<int> pivot_order(std::vector<idx_t>& xadj, std::vector<idx_t>& adj, PetscInt bs,
                              PetscInt N, std::span<const PetscInt> last)
 {
   idx_t n = static_cast<idx_t>(N / bs);
-  std::vector<idx_t> perm(n), iperm(n);
+  std::vector<idx_t> iperm(n);
   std::array<idx_t, METIS_NOPTIONS> options;
   METIS_SetDefaultOptions(options.data());
+  // The `last` nodes (the Schur complement's) are ordered by removing them from the graph
+  // and dissecting the rest, not by moving them out of a dissection of the whole graph: the
+  // dissection then never spends a separator on nodes that are eliminated last anyway. On
+  // the bench's Hertz meshes (MUMPS's analysis): 3D 130k, 91.2M entries and 1.49e11 flops
+  // against 93.1M and 1.57e11; 2D 800k, 71.5M and 2.81e10 against 71.8M and 2.83e10.
+  std::vector<char> gone(n, 0);
+  for (PetscInt r : last)
+    gone[r / bs] = 1;
+  std::vector<idx_t> keep_id(n, -1), kept;
+  for (idx_t v = 0; v < n; ++v)
+    if (!gone[v])
+    {
+      keep_id[v] = static_cast<idx_t>(kept.size());
+      kept.push_back(v);
+    }
+  idx_t nk = static_cast<idx_t>(kept.size());
+  std::vector<idx_t> kx(nk + 1, 0), ka;
+  ka.reserve(adj.size());
+  for (idx_t k = 0; k < nk; ++k)
+  {
+    for (idx_t j = xadj[kept[k]]; j < xadj[kept[k] + 1]; ++j)
+      if (keep_id[adj[j]] >= 0)
+        ka.push_back(keep_id[adj[j]]);
+    kx[k + 1] = static_cast<idx_t>(ka.size());
+  }
+  std::vector<idx_t> kperm(nk), kiperm(nk);
   int rc = METIS_OK;
-  if (n > 0)
-    rc = METIS_NodeND(&n, xadj.data(), adj.data(), nullptr, options.data(), perm.data(),
-                      iperm.data());
+  if (nk > 0)
+    rc = METIS_NodeND(&nk, kx.data(), ka.data(), nullptr, options.data(), kperm.data(),
+                      kiperm.data());
+  // Kept nodes in METIS's order, then the removed ones (whose rows outside `last`, if any,
+  // come just before the `last` rows).
+  for (idx_t k = 0; k < nk; ++k)
+    iperm[kept[k]] = kiperm[k];
+  for (idx_t v = 0, next = nk; v < n; ++v)
+    if (gone[v])
+      iperm[v] = next++;
   if (rc != METIS_OK)
     throw std::runtime_error("METIS_NodeND failed (return code " + std::to_string(rc)
                              + ") on the nodal graph of K (" + std::to_string(n) + " nodes)");

@@ -46,7 +46,9 @@ std::string ordering_name(int infog7);
 
 /// @brief MUMPS's PERM_IN (1-based position of each row in the pivot order) from METIS
 /// nested dissection of the nodal graph of K (blocks of K's block size), serial K only.
-/// The rows `last` (the Schur variables) are put last, in the given order, as MUMPS needs.
+/// The rows `last` (the Schur variables) are put last, in the given order, as MUMPS needs;
+/// their nodes are removed from the graph before it is dissected (less fill than moving them
+/// out of a dissection of the whole graph: docs/architecture.md §4).
 std::vector<int> metis_pivot_order(Mat K, std::span<const PetscInt> last);
 
 /// @brief metis_pivot_order() for a K distributed by rows: the nodal graph of each rank's rows
