@@ -226,9 +226,3 @@ BlockFlexibility flexcontact::blockwise_cholesky(const double* s, std::size_t ld
   }
   return BlockFlexibility(static_cast<Eigen::Index>(n), blocks, std::move(factors));
 }
-
-Eigen::MatrixXd flexcontact::blockwise_inverse(const double* s, std::size_t lda,
-                                               const std::vector<std::vector<int>>& blocks)
-{
-  return blockwise_cholesky(s, lda, blocks).dense();
-}

@@ -5,7 +5,7 @@
 /// @brief Per-body condensation (docs/architecture.md §7): bodies share no DOFs and are coupled only
 /// through contact, so K is block-diagonal by body (up to a permutation), and so are its
 /// Schur complement K*_cc on the contact DOFs and F* = (K*_cc)⁻¹. Each body's block is
-/// inverted on its own: the dense inverse costs Σ n_b³ instead of n_c³.
+/// factored (and, where W needs it, inverted) on its own: Σ n_b³ instead of n_c³.
 ///
 /// The blocks are the connected components of K's sparsity graph restricted to the contact
 /// DOFs: two contact DOFs share a block if and only if a path of structural non-zeros of K
@@ -38,9 +38,4 @@ std::vector<std::vector<int>> block_members(const std::vector<int>& labels);
 /// reciprocal condition number (dpocon, 1-norm) is below 1e3·ε
 BlockFlexibility blockwise_cholesky(const double* s, std::size_t lda,
                                     const std::vector<std::vector<int>>& blocks);
-
-/// @brief F = S⁻¹ as a dense matrix (blockwise_cholesky, each block inverted by dpotri);
-/// entries between blocks are zero.
-Eigen::MatrixXd blockwise_inverse(const double* s, std::size_t lda,
-                                  const std::vector<std::vector<int>>& blocks);
 } // namespace flexcontact
