@@ -82,7 +82,7 @@ def rel_diff(a, b) -> float:
 
 
 def measure(name, split, ref, steps):
-    assert split.one_back_substitution, split.flex_info.get("condense_fallback")
+    assert split.one_back_substitution, split.flex_info.get("method")
     ref.factor = TwoSolves(ref.factor)
     load0 = os.getloadavg()
     worst = 0.0

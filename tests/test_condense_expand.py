@@ -1,5 +1,5 @@
-"""A solve with the serial MUMPS Schur factor split in two halves (dolfinx_ext/src/
-schur_solve.h): condense (forward elimination onto the contact DOFs) and expand (backward
+"""A solve with the MUMPS Schur factor split in two halves (dolfinx_ext/src/
+distributed_schur.h, here on one process): condense (forward elimination onto the contact DOFs) and expand (backward
 substitution from given contact values).
 
 Checked against dense linear algebra on small elasticity problems: the condensed load is
@@ -43,7 +43,7 @@ def condensed_reference(Kd, dofs, b):
 @pytest.mark.parametrize("dim,n,ordering", [(2, 6, "mumps"), (2, 6, "metis"), (3, 3, "metis")])
 def test_condense_expand_is_a_solve(dim, n, ordering):
     msh, K, dofs, F, factor, info = schur_factor(dim, n, ordering)
-    assert info["condense"] and factor.has_condense and info["condense_fallback"] == ""
+    assert info["condense"] and factor.has_condense
     Kd = dense(K)
     b = random_vec(K, 0)
     bt = factor.condense(b)
@@ -106,7 +106,7 @@ def test_misuse_raises():
         factor.expand(np.zeros(dofs.size), x)
     b = random_vec(K, 5)
     factor.condense(b)
-    with pytest.raises(ValueError, match="u_c has 3 entries"):
+    with pytest.raises(ValueError, match="u_c must hold the"):
         factor.expand(np.zeros(3), x)
     factor.expand(np.zeros(dofs.size), x)
     with pytest.raises(RuntimeError, match="no condense"):  # one expansion per condensation
@@ -116,11 +116,8 @@ def test_misuse_raises():
     with pytest.raises(RuntimeError, match="no condense"):
         factor.expand(np.zeros(dofs.size), x)
     short = PETSc.Vec().createSeq(3)
-    with pytest.raises(ValueError, match="b has 3 entries"):
+    with pytest.raises(ValueError, match="b has 3 rows"):
         factor.condense(short)
-    # the petsc4py Mat's own methods stay reachable
-    assert isinstance(factor.mat, PETSc.Mat)
-    assert factor.getSize() == K.getSize()
     factor.destroy()
     with pytest.raises(RuntimeError, match="destroyed"):
         factor.condense(b)

@@ -6,7 +6,7 @@ right-hand side condensed onto the contact DOFs, the kernel's step from it
 The reference is the same problem stepped with full solves through the same factor (v_free,
 then v⁺ = v_free + Ŵ⁻¹ Bᵀ P in steps with contact): the velocities, impulses and energy
 accounts of the two agree to round-off (1e-10 relative) over a whole impact, on one rank
-(the serial SchurFactor) and on two (the DistributedSchur), and the split step costs one
+and on two (the DistributedSchur), and the split step costs one
 back-substitution in every step, with and without contact. Cases: the 10-element bar of
 tests/test_impact.py hitting the held wall obliquely with friction, Rayleigh damping, a
 body load and θ = 0.6 (held contact DOFs); two free bars (no Dirichlet condition at all);

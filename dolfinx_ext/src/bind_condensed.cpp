@@ -161,7 +161,7 @@ void flexcontact::bind_condensed(py::module& m)
           },
           py::arg("b_c"), py::arg("e") = py::none(),
           "One increment from the condensed load b_c = p_c - K_ci K_ii^-1 p_i on the contact "
-          "DOFs (SchurFactor.condense; constrained and rigid-target DOFs: their prescribed "
+          "DOFs (DistributedSchur.condense; constrained and rigid-target DOFs: their prescribed "
           "values): u_p,c = F* b_c, then as step. The dict's solution_c (u_p,c + F* r_c) "
           "expands to K^-1 (p + B^T lambda)")
       .def("set_flexibility", &CondensedContact::set_flexibility, py::arg("F"),

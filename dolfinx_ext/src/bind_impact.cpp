@@ -127,7 +127,7 @@ void flexcontact::bind_impact(py::module& m)
           },
           py::arg("u_c"), py::arg("v_c"), py::arg("b_c"),
           "The step from the condensed right-hand side b_c - What_ci What_ii^-1 b_i "
-          "(SchurFactor.condense of b = h [f - C v- - K (u- + h theta v-)]): the free "
+          "(DistributedSchur.condense of b = h [f - C v- - K (u- + h theta v-)]): the free "
           "velocity v_c + Fhat b_c, then as step(). The dict also holds velocity_change_c "
           "(n_c, Fhat (b_c + r_c): its expansion by the factor is the whole step's "
           "velocity change) and velocity_c (v+ on the contact DOFs)")

@@ -14,7 +14,6 @@
 #include "petsc_error.h"
 #include "ordering.h"
 #include "saved_factor.h"
-#include "schur_solve.h"
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
@@ -27,32 +26,7 @@ using namespace flexcontact;
 
 namespace
 {
-/// @brief The factor handed to Python: a SchurFactor (condense/expand) for the serial Schur
-/// factor when its MUMPS structure is as expected, else the plain petsc4py Mat; `info` gets
-/// "condense" and, for a Schur factor that could not be split, "condense_fallback".
-py::object factor_object(Flexibility& r, std::span<const std::int64_t> dofs, py::dict& info)
-{
-  info["condense"] = false;
-  info["condense_fallback"] = "";
-  if (r.method == "schur" and r.n_contact_dofs > 0 and r.factor)
-  {
-    std::vector<PetscInt> d(dofs.begin(), dofs.end());
-    try
-    {
-      auto s = std::make_unique<SchurSolve>(r.factor, d);
-      MatDestroy(&r.factor); // s holds its own reference
-      info["condense"] = true;
-      return py::cast(std::move(s));
-    }
-    catch (const MumpsLayoutError& e)
-    {
-      info["condense_fallback"] = std::string(e.what());
-    }
-  }
-  return py::cast(r.factor, py::return_value_policy::take_ownership);
-}
-
-/// @brief x = K⁻¹ b by either factor, without the GIL (a solve may wait in MPI collectives).
+/// @brief x = K⁻¹ b by a factor, without the GIL (a solve may wait in MPI collectives).
 template <class Factor>
 void solve_without_gil(Factor& f, Vec b, Vec x)
 {
@@ -60,7 +34,7 @@ void solve_without_gil(Factor& f, Vec b, Vec x)
   f.solve(b, x);
 }
 
-/// @brief Either factor's condensation of b, computed without the GIL, as a NumPy array.
+/// @brief The factor's condensation of b, computed without the GIL, as a NumPy array.
 template <class Factor>
 py::array_t<double> condense_without_gil(Factor& f, Vec b)
 {
@@ -70,54 +44,6 @@ py::array_t<double> condense_without_gil(Factor& f, Vec b)
     c = f.condense(b);
   }
   return py::array_t<double>(static_cast<py::ssize_t>(c.size()), c.data());
-}
-
-void bind_schur_factor(py::module& m)
-{
-  py::class_<SchurSolve>(
-      m, "SchurFactor",
-      "The serial MUMPS factor of K with a Schur complement on the contact DOFs, whose solve "
-      "splits into MUMPS's condensation (forward elimination) and expansion (backward "
-      "substitution). Other attributes are the petsc4py Mat's (`mat`).")
-      .def_property_readonly("has_condense", [](const SchurSolve&) { return true; },
-                             "True: condense and expand exist")
-      .def_property_readonly("n_contact_dofs", &SchurSolve::size)
-      .def_property_readonly(
-          "mat",
-          [](const SchurSolve& s)
-          {
-            if (!s.mat())
-              throw std::logic_error("the MUMPS factor was destroyed");
-            return s.mat();
-          },
-          py::return_value_policy::reference_internal, "The factor as a petsc4py Mat")
-      .def("solve", &solve_without_gil<SchurSolve>, py::arg("b"), py::arg("x"),
-           "x = K^-1 b (a full solve). Collective.")
-      .def("condense", &condense_without_gil<SchurSolve>, py::arg("b"),
-           "MUMPS's condensation of b (forward elimination): the reduced right-hand side "
-           "b_c - K_ci K_ii^-1 b_i on the contact DOFs, in the order given to flexibility. "
-           "MUMPS keeps the interior's part for the next expand. Collective.")
-      .def(
-          "expand",
-          [](SchurSolve& s, py::array_t<double, py::array::c_style | py::array::forcecast> u_c,
-             Vec x)
-          {
-            std::span<const double> u(u_c.data(), u_c.size());
-            py::gil_scoped_release release;
-            s.expand(u, x);
-          },
-          py::arg("u_c"), py::arg("x"),
-          "MUMPS's expansion (backward substitution): x = the solution of K x = b, b of the "
-          "last condense, whose contact values are u_c (K^-1 b when u_c = F* of the condensed "
-          "b). Once per condense. Collective.")
-      .def("destroy", &SchurSolve::destroy, "Release the factor")
-      .def("__getattr__",
-           [](const SchurSolve& s, const std::string& name) -> py::object
-           {
-             if (!s.mat())
-               throw py::attribute_error(name);
-             return py::cast(s.mat(), py::return_value_policy::reference).attr(name.c_str());
-           });
 }
 
 void bind_saved_factor(py::module& m)
@@ -195,9 +121,10 @@ void bind_distributed_schur(py::module& m)
       .def_property(
           "distributed_io", &DistributedSchur::distributed_io,
           &DistributedSchur::set_distributed_io,
-          "True (default): b handed to MUMPS by each rank's rows and the solution returned "
-          "to them (ICNTL(20) = 10, ICNTL(21) = 1); False: b gathered on rank 0 and the "
-          "solution scattered from it (ICNTL(20) = ICNTL(21) = 0). Set it on every rank.")
+          "True (the default on several ranks): b handed to MUMPS by each rank's rows and "
+          "the solution returned to them (ICNTL(20) = 10, ICNTL(21) = 1); False (the default "
+          "on one): b gathered on rank 0 and the solution scattered from it (ICNTL(20) = "
+          "ICNTL(21) = 0). Set it on every rank.")
       .def_property_readonly("io_refusal", &DistributedSchur::io_refusal,
                              "MUMPS's INFOG(1) if it refused the distributed right-hand side "
                              "or solution (the centralised ones are then used), else 0")
@@ -219,8 +146,8 @@ void bind_distributed_schur(py::module& m)
            "Free the MUMPS instance now (otherwise when the object goes).");
 }
 
-/// @brief flexibility()'s `info` dict without the factor's entries (condense,
-/// condense_fallback), which go with the factor object.
+/// @brief flexibility()'s `info` dict without the factor's entry (condense), which goes
+/// with the factor object.
 py::dict flexibility_info(const Flexibility& r)
 {
   py::dict info;
@@ -261,15 +188,10 @@ void bind_flexibility(py::module& m)
           r = flexibility(K, dofs, method, ordering, per_body, factors);
         }
         py::dict info = flexibility_info(r);
-        py::object factor;
-        if (r.distributed)
-        {
-          info["condense"] = true;
-          info["condense_fallback"] = "";
-          factor = py::cast(r.distributed);
-        }
-        else
-          factor = factor_object(r, dofs, info);
+        info["condense"] = static_cast<bool>(r.distributed);
+        py::object factor = r.distributed
+                                ? py::cast(r.distributed)
+                                : py::cast(r.factor, py::return_value_policy::take_ownership);
         info["form"] = r.factors ? "factors" : "dense";
         py::object F = r.factors ? py::cast(r.factors) : py::cast(r.F);
         return py::make_tuple(F, factor, info);
@@ -282,8 +204,9 @@ Parameters: K (petsc4py Mat, symmetric, Dirichlet rows/columns = identity); cont
 (int64 global row indices, on rank 0, empty elsewhere); method "schur" (MUMPS Schur
 complement K*_cc inside the factorization, then F* = inv(K*_cc) by dense Cholesky),
 "inverse_entries" (MUMPS computes the requested entries of inv(K), ICNTL(30)) or
-"matmatsolve" (solve K X = E_c for the contact unit vectors). PETSc cannot solve with a
-Schur factor in parallel, so there "schur" drives MUMPS directly (DistributedSchur).
+"matmatsolve" (solve K X = E_c for the contact unit vectors). With contact DOFs, "schur"
+drives MUMPS directly (DistributedSchur) on any number of processes: PETSc cannot solve with
+a Schur factor in parallel, and in serial its own analysis would be redone for the ordering.
 ordering: MUMPS's fill-reducing ordering, "auto" (the default: "metis" for K of block size
 3, 3D elasticity; "mumps" otherwise), "metis" (METIS nested dissection of the nodal graph
 handed to MUMPS), "mumps" (MUMPS's automatic choice; Debian's MUMPS has AMD, AMF, PORD,
@@ -299,19 +222,17 @@ BlockFlexibility on rank 0 (W is then formed per body by the cheaper route, with
 inverse where the triangular route wins); info["form"] is "factors" or "dense".
 Returns (F, factor, info): F (n_c x n_c, order of contact_dofs) on rank 0, (0, 0) elsewhere;
 factor: the MUMPS factor of K for factor.solve(b, x), the one factorization made; with
-"schur" a SchurFactor on one process, a DistributedSchur on several (factor.has_condense:
-factor.condense(b) and factor.expand(u_c, x) split a solve in two halves), else a petsc4py
-Mat; info:
+"schur" and contact DOFs a DistributedSchur (factor.has_condense: factor.condense(b) and
+factor.expand(u_c, x) split a solve in two halves), else a petsc4py Mat; info:
 method (the one used), n_contact_dofs, null_pivots, factorizations (1), factorization_retries (redone after MUMPS ran out of
 workspace), factorization_s,
 schur_s (Schur extraction / inverse-entries solve / multi-RHS solve), inverse_s, ordering
 (requested), mumps_ordering (used, INFOG(7)), ordering_fallback (why "auto" kept MUMPS's own
 ordering: this PETSc's MUMPS factor cannot take ours; empty otherwise), ordering_s (METIS and the redone analysis,
-part of factorization_s), analysis_s (PETSc's own MUMPS analysis, part of factorization_s),
+part of factorization_s), analysis_s (MUMPS's first analysis, part of factorization_s),
 factor_entries (INFOG(29)), factor_flops (RINFOG(3)),
 factor_memory_mb (INFOG(22)), n_blocks, block_sizes (contact DOFs per block, rank 0),
-blocks_s (finding the blocks), condense (factor is a SchurFactor), condense_fallback (why a
-serial Schur factor could not be split: this PETSc's MUMPS structure; empty otherwise).
+blocks_s (finding the blocks), condense (factor is a DistributedSchur).
 Raises SingularStiffnessError (a RuntimeError) if K is singular, MumpsError/PetscError on
 solver failures, ValueError on bad arguments. Collective.)");
 }
@@ -351,7 +272,6 @@ estimated_flops (RINFOG(1)), estimated_memory_mb (INFOG(17)), analysis_s, orderi
 
 void flexcontact::bind_petsc(py::module& m)
 {
-  bind_schur_factor(m);
   bind_saved_factor(m);
   m.attr("mumps_version") = MUMPS_VERSION;
   py::handle base = m.attr("SolveError");

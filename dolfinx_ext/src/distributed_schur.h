@@ -5,15 +5,17 @@
 /// @brief K factored by one MUMPS instance driven directly on K's communicator, with a
 /// Schur complement on the contact DOFs centralised on rank 0, and the solves through it.
 ///
-/// PETSc refuses a Schur complement with MUMPS on several ranks, so there F* comes from
-/// here: MUMPS reads each rank's rows of K (distributed assembled input, ICNTL(18) = 3: the
+/// F* comes from here on any number of ranks: PETSc refuses a Schur complement with MUMPS on
+/// several, and on one it would run its own analysis only to have it redone for the
+/// requested ordering (the METIS ordering's PERM_IN goes to the first analysis here). MUMPS
+/// reads each rank's rows of K (distributed assembled input, ICNTL(18) = 3: the
 /// upper triangle of the local rows as 1-based triplets, SYM = 2 as PETSc's serial Cholesky),
 /// computes K*_cc = K_cc − K_ci K_ii⁻¹ K_ic on the host (ICNTL(19) = 1: for a symmetric
-/// matrix its lower triangle by rows), and F* = (K*_cc)⁻¹ is inverted block by block there as
-/// in serial. Solves go through MUMPS's condensation (ICNTL(26) = 1: b̃_c = b_c − K_ci K_ii⁻¹
+/// matrix its lower triangle by rows), and F* = (K*_cc)⁻¹ is kept there block by block as
+/// Cholesky factors (block_flexibility.hpp). Solves go through MUMPS's condensation (ICNTL(26) = 1: b̃_c = b_c − K_ci K_ii⁻¹
 /// b_i) and expansion (ICNTL(26) = 2: u from u_c), with u_c = F* b̃_c for a full solve.
 ///
-/// By default the right-hand side and the solution stay distributed (ICNTL(20) = 10: each
+/// On several ranks the right-hand side and the solution stay distributed by default (ICNTL(20) = 10: each
 /// rank hands MUMPS its own rows of b; ICNTL(21) = 1: each rank gets back the rows MUMPS
 /// eliminated there, scattered into x by one VecScatter built at the first expansion), so
 /// an increment moves no N-vector through rank 0; only b̃_c and u_c (n_c values) live on
@@ -98,7 +100,8 @@ public:
   /// the last condense(). Collective.
   void expand(std::span<const double> u_c, Vec x);
 
-  /// @brief Distributed (true, the default) or centralised right-hand side and solution;
+  /// @brief Distributed (true, the default on several ranks) or centralised (the default on
+  /// one) right-hand side and solution;
   /// the same value on every rank. Takes effect at the next condense().
   void set_distributed_io(bool on);
   bool distributed_io() const { return distributed_io_; }
@@ -120,6 +123,7 @@ private:
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0;
+  int size_ = 1;
   DMUMPS_STRUC_C id_{};
   bool alive_ = false;
   int n_c_ = 0;

@@ -207,91 +207,6 @@ Mat factorize(PetscErrorScope& err, Mat K, const std::vector<PetscInt>* schur,
   }
 }
 
-/// @brief Make the dense symmetric n×n matrix `a` (leading dimension lda) whole in place
-/// when MUMPS filled one triangle only (the other exactly zero): copy it across.
-void complete_symmetric(PetscScalar* a, PetscInt n, PetscInt lda)
-{
-  bool upper_zero = true, lower_zero = true;
-  for (PetscInt j = 0; j < n and (upper_zero or lower_zero); ++j)
-    for (PetscInt i = 0; i < j; ++i)
-    {
-      upper_zero = upper_zero and a[i + j * lda] == 0.0;
-      lower_zero = lower_zero and a[j + i * lda] == 0.0;
-    }
-  if (upper_zero == lower_zero) // whole (or diagonal) already
-    return;
-  for (PetscInt j = 0; j < n; ++j)
-    for (PetscInt i = 0; i < j; ++i)
-    {
-      if (upper_zero)
-        a[i + j * lda] = a[j + i * lda];
-      else
-        a[j + i * lda] = a[i + j * lda];
-    }
-}
-
-/// @brief F* = (K*_cc)⁻¹ on rank 0 from the Schur complement of the factor, block by block
-/// (`blocks`: rank 0's positions of each block's contact DOFs), as each block's Cholesky
-/// factor.
-///
-/// The Schur complement is read where MUMPS wrote it, in the factor (no copy: PETSc's
-/// MatFactorCreateSchurComplement copies it, 0.5 s at 4,000 contact DOFs); its missing
-/// triangle is filled in, which leaves it the same matrix for PETSc's later full solves.
-BlockFlexibility cholesky_of_schur(PetscErrorScope& err, MPI_Comm comm, int rank, Mat F,
-                                   int n_c, const std::vector<std::vector<int>>& blocks,
-                                   double& schur_s, double& cholesky_s)
-{
-  double t0 = MPI_Wtime();
-  Mat S = nullptr; // borrowed from F
-  MatFactorSchurStatus status;
-  err.check(MatFactorGetSchurComplement(F, &S, &status), "MatFactorGetSchurComplement");
-  if (status != MAT_FACTOR_SCHUR_UNFACTORED)
-    throw std::runtime_error("the Schur complement of the factor is not in its unfactored "
-                             "state (status " + std::to_string(static_cast<int>(status)) + ")");
-  if (rank == 0)
-  {
-    PetscInt m = 0, lda = 0;
-    err.check(MatGetSize(S, &m, nullptr), "MatGetSize");
-    err.check(MatDenseGetLDA(S, &lda), "MatDenseGetLDA");
-    PetscScalar* a = nullptr;
-    err.check(MatDenseGetArray(S, &a), "MatDenseGetArray");
-    complete_symmetric(a, m, lda);
-    err.check(MatDenseRestoreArray(S, &a), "MatDenseRestoreArray");
-  }
-  double t1 = MPI_Wtime();
-  schur_s = t1 - t0;
-
-  BlockFlexibility Fs;
-  bool singular = false;
-  std::string what;
-  if (rank == 0)
-  {
-    PetscInt m = 0, n = 0, lda = 0;
-    err.check(MatGetSize(S, &m, &n), "MatGetSize");
-    if (m != n_c or n != n_c)
-      throw std::runtime_error("Schur complement has size " + std::to_string(m) + "x"
-                               + std::to_string(n) + ", expected " + std::to_string(n_c));
-    err.check(MatDenseGetLDA(S, &lda), "MatDenseGetLDA");
-    const PetscScalar* a = nullptr;
-    err.check(MatDenseGetArrayRead(S, &a), "MatDenseGetArrayRead");
-    try
-    {
-      Fs = blockwise_cholesky(a, static_cast<std::size_t>(lda), blocks);
-    }
-    catch (const SingularStiffnessError& e)
-    {
-      singular = true;
-      what = e.what();
-    }
-    err.check(MatDenseRestoreArrayRead(S, &a), "MatDenseRestoreArrayRead");
-  }
-  err.check(MatFactorRestoreSchurComplement(F, &S, status), "MatFactorRestoreSchurComplement");
-  throw_collective_if(comm, singular, what,
-                      [](const std::string& w) { throw SingularStiffnessError(w); });
-  cholesky_s = MPI_Wtime() - t1;
-  return Fs;
-}
-
 /// @brief F* = rows c of X, K X = E_c, gathered on rank 0.
 Eigen::MatrixXd multi_rhs_solve(PetscErrorScope& err, MPI_Comm comm, int rank, Mat K, Mat F,
                                 const std::vector<PetscInt>& dofs)
@@ -513,9 +428,10 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
   dofs.resize(n_c);
   MPI_Bcast(dofs.data(), n_c, MPIU_INT, 0, comm);
 
-  // PETSc cannot solve with a Schur-enabled MUMPS factor in parallel: there "schur" drives
-  // MUMPS directly (distributed_schur.h), with the same ordering as in serial.
-  const bool direct = method == "schur" and size > 1;
+  // "schur" drives MUMPS directly (distributed_schur.h) on any number of ranks: PETSc cannot
+  // solve with a Schur-enabled MUMPS factor in parallel, and in serial its own analysis would
+  // be thrown away for the requested ordering (a second analysis).
+  const bool direct = method == "schur" and n_c > 0;
   const std::string used = method;
 
   Flexibility out;
@@ -554,26 +470,6 @@ Flexibility flexcontact::flexibility(Mat K, std::span<const std::int64_t> contac
     out.factorization_s = MPI_Wtime() - t0;
     out.factorizations = 1;
     out.F.resize(0, 0);
-  }
-  else if (used == "schur")
-  {
-    // Serial only (see `used`): the Schur-enabled factor also serves MatSolve.
-    std::vector<PetscInt> root_dofs = rank == 0 ? dofs : std::vector<PetscInt>();
-    double t0 = MPI_Wtime();
-    OwnedMat F;
-    F.m = factorize(err, K, &root_dofs, out.ordering, out);
-    out.factorization_s = MPI_Wtime() - t0;
-    out.factorizations = 1;
-    double cholesky_s = 0.0;
-    BlockFlexibility Fs = cholesky_of_schur(err, comm, rank, F.m, n_c, blocks, out.schur_s,
-                                            cholesky_s);
-    double t1 = MPI_Wtime();
-    if (rank == 0 and factors)
-      out.factors = std::make_shared<BlockFlexibility>(std::move(Fs));
-    else if (rank == 0)
-      out.F = Fs.dense();
-    out.inverse_s = cholesky_s + (MPI_Wtime() - t1);
-    out.factor = F.release();
   }
   else
   {

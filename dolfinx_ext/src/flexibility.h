@@ -93,12 +93,12 @@ struct Flexibility
 /// blocks. With `per_body` false all contact DOFs form one block (F* equal up to rounding).
 ///
 /// * "schur": MUMPS computes the Schur complement K*_cc = K_cc − K_cr K_rr⁻¹ K_rc inside the
-///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ by LAPACK's dense Cholesky
-///   inverse (dpotrf, dpotri) of each block. The
-///   returned factor is the same factorization (PETSc runs MUMPS's condensation and
-///   expansion phases around the Schur solve, so MatSolve gives K⁻¹b). PETSc cannot solve
-///   with a Schur factor in parallel, so with more than one rank MUMPS is driven directly
-///   (distributed_schur.h): the factor is then Flexibility::distributed, and `factor` null.
+///   factorization (centralised on rank 0), and F* = (K*_cc)⁻¹ is kept as each block's
+///   Cholesky factor (dpotrf; the dense F* by dpotri unless `factors`). With contact DOFs,
+///   on any number of ranks, MUMPS is driven directly (distributed_schur.h: PETSc cannot
+///   solve with a Schur factor in parallel, and in serial would analyse twice for our
+///   ordering): the factor is Flexibility::distributed, whose solves run MUMPS's
+///   condensation and expansion around F*, and `factor` is null.
 /// * "inverse_entries": one plain factorization, then MUMPS computes the n_c² requested
 ///   entries of K⁻¹ directly (ICNTL(30), PETSc's MatMumpsGetInverse), exploiting the sparsity
 ///   of the unit right-hand sides. Serial and parallel.

@@ -14,8 +14,7 @@ distributed):
    with or without contact;
 4. u⁺ = u⁻ + h (θ v⁺ + (1 − θ) v⁻).
 
-With a factor that cannot split (another flexibility method, or a PETSc whose MUMPS layout
-is not the expected one: ``flex_info["condense_fallback"]``), v_free = v⁻ + Ŵ⁻¹ r is a full
+With a factor that cannot split (another flexibility method), v_free = v⁻ + Ŵ⁻¹ r is a full
 solve, the kernel's ``step`` takes it, and steps with contact add v⁺ = v_free + Ŵ⁻¹ Bᵀ P,
 a second solve.
 

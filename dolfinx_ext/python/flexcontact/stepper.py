@@ -10,8 +10,8 @@ increment, Ŵ = M + hθC + h²θ²K for a time step), the stepper returns
 and the kernel's step dict, where λ (or the impulses P) solves the condensed contact
 problem built from A⁻¹ b:
 
-* with a factor that splits its solves (``factor.has_condense``: MUMPS's Schur factor, serial
-  or distributed), b is condensed onto the contact DOFs (forward elimination), the kernel
+* with a factor that splits its solves (``factor.has_condense``: MUMPS's Schur factor on one
+  rank or several), b is condensed onto the contact DOFs (forward elimination), the kernel
   step takes the condensed values and returns the contact values of y, and the expansion
   finishes the one back-substitution;
 * otherwise y₀ = A⁻¹ b is a full solve, the kernel step takes its contact values, and a
