@@ -27,13 +27,6 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
                                    std::vector<int> perm_in)
 {
   PetscErrorScope err;
-  comm_ = PetscObjectComm(reinterpret_cast<PetscObject>(K));
-  MPI_Comm_rank(comm_, &rank_);
-  MPI_Comm_size(comm_, &size_);
-  // On one rank the centralised variant is a plain copy each way, while the distributed
-  // one scatters the solution by MUMPS's elimination order (measured, 7,442 rows: 1.30
-  // against 1.37 ms per condensation and expansion).
-  distributed_io_ = size_ > 1;
   err.check(MatGetSize(K, &n_, nullptr), "MatGetSize");
   if (n_ > std::numeric_limits<int>::max() - 1)
     throw std::invalid_argument("K has " + std::to_string(n_) + " rows: more than MUMPS's "
@@ -47,13 +40,27 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
     irhs_loc_[r - rstart_] = static_cast<int>(r + 1);
   rhs_loc_.assign(irhs_loc_.size(), 0.0);
 
+  // MUMPS keeps the communicator until its termination, which may come after K and every
+  // other PETSc object on K's communicator are gone (PETSc then frees its inner one; MUMPS 5.7
+  // refuses the termination, INFO(1) = -3): this instance holds its own duplicate, freed by
+  // release() (which every later failure of this constructor calls).
+  MPI_Comm_dup(PetscObjectComm(reinterpret_cast<PetscObject>(K)), &comm_);
+  MPI_Comm_rank(comm_, &rank_);
+  MPI_Comm_size(comm_, &size_);
+  // On one rank the centralised variant is a plain copy each way, while the distributed
+  // one scatters the solution by MUMPS's elimination order (measured, 7,442 rows: 1.30
+  // against 1.37 ms per condensation and expansion).
+  distributed_io_ = size_ > 1;
   id_.job = -1;
   id_.par = 1; // the host works too
   id_.sym = 2; // symmetric, LDLᵀ with pivoting, as PETSc's Cholesky of K in serial
   id_.comm_fortran = static_cast<int>(MPI_Comm_c2f(comm_));
   dmumps_c(&id_);
   if (infog(id_, 1) < 0)
+  {
+    release();
     throw_mumps_error("initialization", infog(id_, 1), infog(id_, 2));
+  }
   alive_ = true;
   try
   {
@@ -145,6 +152,8 @@ void DistributedSchur::release()
   condensed_ = false;
   int finalized = 0;
   MPI_Finalized(&finalized);
+  if (!finalized and comm_ != MPI_COMM_NULL)
+    MPI_Comm_free(&comm_);
   if (!finalized and !PetscFinalizeCalled)
   {
     VecScatterDestroy(&to_zero_);
