@@ -280,8 +280,16 @@ void DistributedSchur::condense_centralised(Vec b)
 {
   PetscErrorScope err;
   double t0 = MPI_Wtime();
-  Vec whole = b; // on one rank b is whole: no gather
-  if (size_ > 1)
+  Vec whole = b; // on one rank b is whole: no gather, only its size to check
+  if (size_ == 1)
+  {
+    PetscInt n_b = 0;
+    err.check(VecGetSize(b, &n_b), "VecGetSize");
+    if (n_b != n_)
+      throw std::invalid_argument("condense: b has " + std::to_string(n_b) + " rows, K "
+                                  + std::to_string(n_));
+  }
+  else // the gather checks b's layout, collectively
   {
     if (!to_zero_) // only this variant needs the N values on rank 0
       err.check(VecScatterCreateToZero(b, &to_zero_, &host_), "VecScatterCreateToZero");
@@ -289,14 +297,6 @@ void DistributedSchur::condense_centralised(Vec b)
               "VecScatterBegin");
     err.check(VecScatterEnd(to_zero_, b, host_, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
     whole = host_;
-  }
-  if (size_ == 1) // on several ranks the gather checks b's layout, collectively
-  {
-    PetscInt n_b = 0;
-    err.check(VecGetSize(b, &n_b), "VecGetSize");
-    if (n_b != n_)
-      throw std::invalid_argument("condense: b has " + std::to_string(n_b) + " rows, K "
-                                  + std::to_string(n_));
   }
   if (rank_ == 0)
   {
