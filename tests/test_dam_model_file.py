@@ -42,6 +42,9 @@ def cli(*args):
 def test_what_if_in_a_new_process_equals_the_factoring_evaluator(model):
     path, manifest = model
     assert manifest["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1}
+    # The 2D section's Ŵ is kept as the split factor's arrays, K as MUMPS's files.
+    assert manifest["factors"]["stage2"]["kind"] == model_file.SPLIT
+    assert "kind" not in manifest["factors"]["stage1"]
     r = cli("what-if", path, *[a for k, v in ASKED.items()
                                for a in ("--" + k.replace("_", "-"), v)], "--json")
     assert r.returncode == 0, r.stderr
@@ -145,6 +148,7 @@ def test_a_3d_model_answers_in_a_new_process_as_the_factoring_evaluator(tmp_path
     manifest = model_file.prepare(BASE_3D, dt, levels, path, lags=0, progress=lambda *a: None,
                                   logs=[BASE_3D])
     assert manifest["inputs"]["patch_y_m"][0] > 0.0
+    assert "kind" not in manifest["factors"]["stage2"]  # the 3D block: MUMPS's files
     assert len(manifest["logs"]) == 1
     r = cli("what-if", path, *[a for k, v in ASKED_3D.items()
                                for a in ("--" + k.replace("_", "-"), v)], "--json")

@@ -96,6 +96,8 @@ def test_factorizations_once_for_a_loop_over_speed_pitch_friction_and_water(eval
             solves[body] += n
     c = evaluator.counts()
     assert c["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 1}, c
+    # The 2D section is small: its Ŵ takes the sparse split factor (split_factor.py).
+    assert evaluator.dam.flex_info["factor"] == "split", evaluator.dam.flex_info
     assert c["back_substitutions"]["dam_stage1"] == 2, c  # one per water level
     assert c["back_substitutions"]["dam_stage2"] - before["dam_stage2"] == solves["dam"]
     assert c["back_substitutions"]["log"] - before["log"] == solves["log"]

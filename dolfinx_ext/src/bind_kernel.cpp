@@ -531,4 +531,5 @@ void flexcontact::bind_kernel(py::module& m)
   bind_condensed(m);
   bind_impact(m);
   bind_problem_file(m);
+  bind_split_cholesky(m);
 }

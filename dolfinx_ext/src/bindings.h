@@ -40,6 +40,8 @@ void bind_operator(pybind11::module& m);
 void bind_impact(pybind11::module& m);
 /// @brief problem_file.hpp: LocalProblem, read_local_problem.
 void bind_problem_file(pybind11::module& m);
+/// @brief split_cholesky.hpp: a small body's sparse split factor.
+void bind_split_cholesky(pybind11::module& m);
 
 // Conversions shared by the step bindings (bind_convert.cpp): what crosses back to Python is
 // plain NumPy and dicts, picklable so that rank 0 can broadcast it.

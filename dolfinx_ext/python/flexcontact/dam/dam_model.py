@@ -12,7 +12,9 @@ made once per dam mesh:
   0.4 m facets);
 * stage 2: Ŵ = M + hθC + h²θ²K at the sweep's time step, factored once, and its condensed
   flexibility W_face = S Ŵ⁻¹ Sᵀ on every DOF of the face strip's nodes (``_cpp.flexibility``,
-  the same call as Condensation), dense.
+  the same call as Condensation), dense. A dam of at most split_factor.SPLIT_LIMIT DOFs (the
+  2D section) is factored by the sparse split factor instead, whose solves have no set-up
+  per call.
 
 During an impact the dam's state is split as u = u_static + w: u_static is the stage-1
 equilibrium under the constant loads, so w (and its velocity) obey the homogeneous
@@ -46,6 +48,7 @@ from ..forms import elasticity_form, lame_fields, mass_form, max_principal_stres
 from ..meshes import dam as dam_mesh
 from ..meshes import dam_tags as T
 from ..pairing import _candidate_surface
+from ..split_factor import SplitFactor
 from .section import BaseSection, offset_sample_cells
 from .stage1 import DamMesh, _measures, _sections, body_loads
 from .stage2 import stage2_supports
@@ -154,7 +157,8 @@ class DamModel:
         # factored, the restorations are counted instead.
         self._restored = restored
         # saveable: K and Ŵ factored as SavedFactors (model_file.prepare writes them, no
-        # second factorization); Ŵ then has no Schur split, and W_face comes from its solves.
+        # second factorization); Ŵ then has no Schur split, and W_face comes from its solves,
+        # unless Ŵ is small enough for the split factor, whose arrays are saved instead.
         self._saveable = bool(saveable) and restored is None
         self._compliance = ({0: restored["face_compliance_x"]}
                             if restored is not None and "face_compliance_x" in restored else {})
@@ -253,12 +257,22 @@ class DamModel:
         self.face_dofs = np.asarray(self.face["dofs"], np.int64).reshape(-1)
         if self._restored is not None:
             self.factor = self._restored["stage2"]
+            if int(self.factor.size) != self.W_hat.getSize()[0]:
+                raise SolveError(f"a stage-2 factor of {int(self.factor.size)} rows restored "
+                                 f"for a dam of {self.W_hat.getSize()[0]} DOFs")
             self.W_face = np.asarray(self._restored["W_face"])
             if self.W_face.shape != (self.face_dofs.size,) * 2:
                 raise SolveError(f"W_face of shape {self.W_face.shape} restored for a face of "
                                  f"{self.face_dofs.size} DOFs")
             self.restorations["dam_stage2"] += 1
             self.flex_info = {"restored": True}
+        elif SplitFactor.worth_it(self.W_hat.getSize()[0]):
+            # A small dam (the 2D section): MUMPS's set-up per solve would be most of a step.
+            # Its arrays are what a model file keeps, so a saveable model takes it too.
+            self.factor = SplitFactor(self.W_hat, self.face_dofs)
+            self.W_face = self.factor.W
+            self.factorizations["dam_stage2"] += 1
+            self.flex_info = {"factor": "split", "factor_entries": self.factor.factor_entries}
         elif self._saveable:
             from ..saved_factor import factor_matrix
             self.factor = factor_matrix(self.W_hat)

@@ -10,7 +10,10 @@ The model is one directory, written atomically (complete or absent):
   functions (dam/response.py), the face compliance of the re-contact bound, and the static
   displacement of each water level it was asked for;
 * MUMPS's own files of the two factors, K (stage 1: another water level in the range is one
-  back-substitution) and Ŵ (stage 2), written and checked by flexcontact.saved_factor.
+  back-substitution) and Ŵ (stage 2), written and checked by flexcontact.saved_factor; a Ŵ
+  small enough for the sparse split factor (the 2D section, split_factor.SPLIT_LIMIT) is
+  kept in ``arrays.npz`` instead (its pivot order and Cholesky factor), so that a restored
+  2D dam condenses and expands as the one that factored it.
 
 Loading rebuilds the dam's mesh and assembles its matrices (no factorization), checks that
 the mesh numbers its DOFs as the saved one did, and restores the factors. Only a changed
@@ -30,10 +33,15 @@ import numpy as np
 from mpi4py import MPI
 
 from .. import saved_factor
+from ..split_factor import SplitFactor
 from ..errors import InputError, SavedFileError
 
-MODEL_FORMAT = 1
-"""The model directory's format: a model of another format is refused."""
+MODEL_FORMAT = 2
+"""The model directory's format: a model of another format is refused (2: a factor may be
+held in arrays.npz, "kind": "split")."""
+
+SPLIT = "split"
+"""The manifest's "kind" of a factor kept in arrays.npz (split_factor.SplitFactor)."""
 
 
 def inputs_of(base, dt_s: float, water_levels_m, strip_m, patch_y_m=None) -> dict:
@@ -86,10 +94,14 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
     tmp.mkdir(parents=True)
     try:
         factors = {}
-        for name, f in (("stage1", dam._factor1), ("stage2", dam.factor)):
-            factors[name] = saved_factor.save_factor(f, tmp, name)
         arrays = {"W_face": dam.W_face, "face_dofs": dam.face_dofs,
                   "face_compliance_x": compliance}
+        for name, f in (("stage1", dam._factor1), ("stage2", dam.factor)):
+            if isinstance(f, SplitFactor):
+                arrays.update(f.arrays(name + "_"))
+                factors[name] = {"name": name, "kind": SPLIT, "rows": f.n}
+            else:
+                factors[name] = saved_factor.save_factor(f, tmp, name)
         arrays.update(responses.saved())
         kept_logs = _log_arrays(base, dam, logs, arrays)
         for i, (z, st) in enumerate(statics.items()):
@@ -164,7 +176,8 @@ def read_manifest(path) -> dict:
             raise SavedFileError(f"{p}: its SHA-256 differs from the saved one (the file was "
                                  "altered)")
     for entry in manifest["factors"].values():
-        saved_factor.check_factor_files(path, entry)
+        if entry.get("kind") != SPLIT:  # a split factor's arrays were checked above
+            saved_factor.check_factor_files(path, entry)
     return manifest
 
 
@@ -195,10 +208,11 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
     manifest = read_manifest(path)
     inputs = manifest["inputs"]
     base = DamScenario.from_dict(inputs["base"])
-    restored = {name: saved_factor.restore_factor(path, entry)
-                for name, entry in manifest["factors"].items()}
     with np.load(path / "arrays.npz") as z:
         arrays = {k: z[k] for k in z.files}
+    restored = {name: (SplitFactor.from_arrays(arrays, name + "_") if entry.get("kind") == SPLIT
+                       else saved_factor.restore_factor(path, entry))
+                for name, entry in manifest["factors"].items()}
     restored["W_face"] = arrays["W_face"]
     restored["face_compliance_x"] = arrays["face_compliance_x"]
     dam = DamModel(base, inputs["dt_s"], tuple(inputs["water_levels_m"]), comm,
