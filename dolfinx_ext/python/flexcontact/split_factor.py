@@ -17,6 +17,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from . import _cpp
+from .errors import InputError
 
 SPLIT_LIMIT = 4000
 """Largest serial body (DOFs) given the sparse split factor instead of MUMPS's Schur factor."""
@@ -31,7 +32,7 @@ class SplitFactor:
 
     def __init__(self, A: PETSc.Mat, dofs):
         if A.getComm().getSize() != 1:
-            raise ValueError(f"SplitFactor: a matrix on {A.getComm().getSize()} ranks; the "
+            raise InputError(f"SplitFactor: a matrix on {A.getComm().getSize()} ranks; the "
                              "sparse split factor is serial")
         ai, aj, av = A.getValuesCSR()
         self.c = np.asarray(dofs, np.int64).reshape(-1)
