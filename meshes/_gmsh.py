@@ -99,13 +99,16 @@ def physical(dim: int, entities, tag: int, name: str):
 
 
 def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float,
-               dist_far: float, points_per_curve: int = 20, boxes=(), balls=()):
+               dist_far: float, points_per_curve: int = 20, boxes=(), balls=(),
+               balls_only_in=None):
     """Background mesh size (m): h_near within dist_near of the ``dim``-entities (curves or
     surfaces), growing linearly to h_far at dist_far. ``boxes``: extra caps
     ``(size, x0, y0, z0, x1, y1, z1)``; inside such a box the size never exceeds ``size``.
     ``balls``: caps ``(size, x, y, z, radius, thickness)``, the size inside the ball of that
-    radius, blending to the rest over ``thickness``. Sizes from points and curvature are
-    switched off."""
+    radius, blending to the rest over ``thickness``; ``balls_only_in``: volume tags to which
+    the balls are restricted (with their faces, curves and points: gmsh 4.11 applies a
+    restriction to the listed entities only). Sizes from points and curvature are switched
+    off."""
     field = gmsh.model.mesh.field
     f_dist = field.add("Distance")
     field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[dim], list(entities))  # 4.8 names
@@ -129,6 +132,8 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
         for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
                          ("Thickness", thickness), ("VIn", size), ("VOut", h_far)):
             field.setNumber(f_ball, key, val)
+        if balls_only_in:
+            f_ball = _restricted(f_ball, balls_only_in)
         fields.append(f_ball)
     if len(fields) > 1:
         f_min = field.add("Min")
@@ -138,6 +143,21 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+
+
+def _restricted(f_in: int, volumes) -> int:
+    """A Restrict field applying ``f_in`` in ``volumes`` and on their closure."""
+    field = gmsh.model.mesh.field
+    vols = [(3, v) for v in volumes]
+    faces = gmsh.model.getBoundary(vols, combined=False, oriented=False)
+    curves = gmsh.model.getBoundary(faces, combined=False, oriented=False)
+    points = gmsh.model.getBoundary(vols, combined=False, oriented=False, recursive=True)
+    f = field.add("Restrict")
+    field.setNumber(f, "InField", f_in)
+    for key, dimtags in (("VolumesList", vols), ("SurfacesList", faces),
+                         ("CurvesList", curves), ("PointsList", points)):
+        field.setNumbers(f, key, sorted({abs(t) for _, t in dimtags}))
+    return f
 
 
 # ---- finding OpenCASCADE entities by position (builders call these inside their model) --
