@@ -9,9 +9,11 @@
 #
 # By default the dam is a 3D block between contraction joints (15 m wide, `--dam-width`) on
 # its foundation, and the log a round one, pitched 10° (`--log-pitch`, `--log-yaw`), whose
-# front end crushes at the wood's crushing strength (docs/crushing.md); the mesh is refined
-# about the first-contact point so that the crushed patch at the peak force spans at least
-# four elements (CRUSHED_PATCH_MESH). `--elastic-end` keeps the end elastic (the upper bound
+# front end crushes at the wood's crushing strength (docs/crushing.md); the log's end is
+# refined about the first-contact point so that the crushed patch at the peak force spans at
+# least four elements (CRUSHED_PATCH_MESH), and the rest has elements of 0.2 m on the log and
+# near it, 3 m far from it (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study
+# below says why). `--elastic-end` keeps the end elastic (the upper bound
 # of the force); `--log-end` shapes it (flat, chamfered, rounded). `--dim 2` runs the
 # plane-strain section instead: per metre of dam, a raft of logs abreast along the whole
 # crest, not one log.
@@ -76,6 +78,11 @@ parser.add_argument("--contact-size", type=float, default=None,
                          "the impact zone's)")
 parser.add_argument("--contact-zone", type=float, default=None,
                     help="radius (m) of the refined ball about the first-contact point")
+parser.add_argument("--far-size", type=float, default=None,
+                    help="element size far from the log, m (default: MAIN_JOB_MESH, 3 m)")
+parser.add_argument("--impact-size", type=float, default=None,
+                    help="element size on the log and within 1 m of it, m (default: "
+                         "MAIN_JOB_MESH, 0.2 m)")
 parser.add_argument("--offset", type=float, default=1.0,
                     help="distance from the heel at which the peak stress is reported, m")
 parser.add_argument("--stage1-only", action="store_true", help="skip the impact (stage 2)")
@@ -90,6 +97,11 @@ parser.add_argument("--duration", type=float, default=None,
 parser.add_argument("--mesh-study", action="store_true",
                     help="run the impact on two finer meshes (sizes / sqrt 2 and / 2) and "
                          "extrapolate")
+parser.add_argument("--mesh-study-contact", choices=("refined", "kept"), default=None,
+                    help="the mesh study's crushed-patch contact mesh: refined with the rest, "
+                         "or kept at its size while the dam's and log's near and far field "
+                         "are refined (default: refined in 2D, kept in 3D, where refining "
+                         "the patch too does not fit in 24 GB)")
 parser.add_argument("--contact-operator", choices=("dense", "factor"), default="dense",
                     help="how the impact holds the log/dam contact: dense F-hat and W_eff, or "
                          "through the factor of the iteration matrix, for contact zones too "
@@ -108,9 +120,10 @@ t_start = time.perf_counter()
 # meshed. The log's elevation is not an input: it floats at its draft.
 
 # %%
-from flexcontact.dam.scenario import CRUSHED_PATCH_MESH
+from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
 crushes = not args.elastic_end
 size, zone = CRUSHED_PATCH_MESH[args.dim] if crushes else (None, 0.1)
+far_size, impact_size = MAIN_JOB_MESH[args.dim]
 scenario = DamScenario(
     dim=args.dim, dam_width_m=args.dam_width, refine=args.refine,
     water_level_m=args.water_level,
@@ -120,7 +133,9 @@ scenario = DamScenario(
     friction_mu=args.mu, westergaard=args.westergaard, log_end_crushes=crushes,
     log_end_shape=args.log_end, log_end_chamfer_m=args.end_chamfer,
     log_end_radius_m=args.end_radius,
-    mesh_size_contact_m=args.contact_size or size, contact_zone_m=args.contact_zone or zone)
+    mesh_size_contact_m=args.contact_size or size, contact_zone_m=args.contact_zone or zone,
+    mesh_size_far_m=args.far_size or far_size,
+    mesh_size_impact_m=args.impact_size or impact_size)
 folder = fc.results_folder("dam_debris")
 
 # %% [markdown]
@@ -309,6 +324,9 @@ if not args.stage1_only and not args.no_paraview:
 # √2 and by 2, near field and far field together (no output files). The report tabulates
 # the three, extrapolates each quantity (Richardson), and gives the observed order and the
 # default mesh's grid convergence index, or says where the meshes are not asymptotic.
+# In 3D the crushed patch's contact mesh is kept at its size and the rest refined
+# (`--mesh-study-contact kept`, the default there): refining the patch too multiplies the
+# contact DOFs beyond this machine's memory.
 
 # %%
 rows = None
@@ -316,10 +334,13 @@ if args.mesh_study and not args.stage1_only:
     from flexcontact.dam.convergence import RATIO
     from flexcontact.dam.key_numbers import study_scenarios
     rows = [{**numbers, "refine": s.refine, "h_impact_m": s.h_impact_m, "h_far_m": s.h_far_m,
-             "cells": summary["mesh"]["cells"]}]
-    for finer in study_scenarios(s, RATIO)[1:]:
+             "h_contact_m": s.h_contact_m, "cells": summary["mesh"]["cells"],
+             "dofs": summary["mesh"]["dofs"]}]
+    study_contact = args.mesh_study_contact or ("kept" if s.dim == 3 else "refined")
+    for finer in study_scenarios(s, RATIO, study_contact)[1:]:
         if comm.rank == 0:
-            print(f"mesh study: h impact {finer.h_impact_m:.3g} m, far {finer.h_far_m:.3g} m")
+            print(f"mesh study: h impact {finer.h_impact_m:.3g} m, far {finer.h_far_m:.3g} m, "
+                  f"contact {finer.h_contact_m:.3g} m", flush=True)
         rows.append(mesh_study_row(finer, args.impact_offset, duration_s=duration, comm=comm,
                                    contact_operator=args.contact_operator))
     summary["mesh_study"] = rows

@@ -59,3 +59,36 @@ def test_report_tabulates_the_three_meshes_and_the_estimate():
     assert "| 1.00 |" in heel and "11.4 %" in heel
     toe = next(line for line in text.splitlines() if line.startswith("| Δσ toe"))
     assert "not asymptotic" in toe
+
+
+def test_the_study_can_keep_the_crushed_patch_mesh():
+    """contact="kept": far and impact sizes / √2 and / 2, the contact zone's size unchanged;
+    "refined" divides it too; another word is refused by name."""
+    from flexcontact.dam import DamScenario
+    from flexcontact.dam.key_numbers import study_scenarios
+    s = DamScenario(dim=3, mesh_size_contact_m=0.0125, contact_zone_m=0.35)
+    kept = study_scenarios(s, RATIO, "kept")
+    refined = study_scenarios(s, RATIO)
+    for k, (a, b) in enumerate(zip(kept, refined)):
+        assert a.h_far_m == pytest.approx(s.h_far_m / RATIO ** k, rel=1e-12)
+        assert a.h_impact_m == pytest.approx(s.h_impact_m / RATIO ** k, rel=1e-12)
+        assert a.h_contact_m == s.h_contact_m
+        assert b.h_contact_m == pytest.approx(s.h_contact_m / RATIO ** k, rel=1e-12)
+    with pytest.raises(InputError, match="contact='coarse'"):
+        study_scenarios(s, RATIO, "coarse")
+
+
+def test_report_says_when_the_contact_mesh_was_kept():
+    from flexcontact.dam.impact_report import _mesh_study
+    from flexcontact.dam.key_numbers import CONVERGENCE_QUANTITIES, MESH_STUDY_COLUMNS
+    rows = []
+    for k, h in enumerate((1.0, 1.0 / RATIO, 0.5)):
+        row = {key: 1.0 for key, _, _ in MESH_STUDY_COLUMNS}
+        row.update({key: 2.0 + 0.2 * h for key, _, _ in CONVERGENCE_QUANTITIES})
+        row.update(h_impact_m=0.4 * h, h_far_m=6.0 * h, h_contact_m=0.0125, cells=100,
+                   dofs=300 * (k + 1))
+        rows.append(row)
+    text = "\n".join(_mesh_study(rows))
+    assert "(the crushed patch's, 12.5 mm) are kept" in text
+    assert "every element size but the contact zone's divided by 1.41" in text
+    assert "| 0.4 | 6 | 12.5 | 100 | 300 |" in text
