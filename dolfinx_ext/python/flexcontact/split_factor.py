@@ -41,21 +41,22 @@ class SplitFactor:
 
     @classmethod
     def from_arrays(cls, arrays: dict, prefix: str) -> "SplitFactor":
-        """The factor of :meth:`arrays` (no factorization)."""
+        """The factor of :meth:`arrays` (no factorization; W from L_cc, n_c³ flops)."""
         self = cls.__new__(cls)
         get = lambda k: np.asarray(arrays[f"{prefix}{k}"])  # noqa: E731
-        self._f = _cpp.SplitCholesky(get("order").astype(np.int32), int(get("n_schur")[0]),
-                                     get("indptr"), get("indices"), get("values"))
-        self.c, self.W = get("c").astype(np.int64), get("W")
+        order, n_c = get("order").astype(np.int32), int(get("n_schur")[0])
+        self._f = _cpp.SplitCholesky(order, n_c, get("indptr"), get("indices"), get("values"))
+        self.c = order[order.size - n_c:].astype(np.int64)  # the contact rows pivot last
+        self.W = np.asarray(self._f.flexibility())
         return self
 
     def arrays(self, prefix: str) -> dict:
-        """The pivot order, L and W, to be saved (named ``prefix`` + name)."""
+        """The pivot order and L, to be saved (named ``prefix`` + name)."""
         parts = self._f.arrays()
         return {f"{prefix}order": np.asarray(parts["order"], np.int32),
                 f"{prefix}n_schur": np.array([parts["n_schur"]]),
                 f"{prefix}indptr": parts["indptr"], f"{prefix}indices": parts["indices"],
-                f"{prefix}values": parts["values"], f"{prefix}c": self.c, f"{prefix}W": self.W}
+                f"{prefix}values": parts["values"]}
 
     @staticmethod
     def worth_it(n: int, comm_size: int = 1) -> bool:
