@@ -21,25 +21,24 @@ const std::string kWho = "SplitCholesky: ";
 std::vector<int> pivot_order(Eigen::Index n, std::span<const int> indptr,
                              std::span<const int> indices, const std::vector<int>& schur)
 {
-  std::vector<int> interior_id(static_cast<std::size_t>(n), 0);
+  std::vector<char> is_contact(static_cast<std::size_t>(n), 0);
   for (int r : schur)
   {
     if (r < 0 || r >= n)
       throw std::invalid_argument(kWho + "contact row " + std::to_string(r)
                                   + " out of range for " + std::to_string(n) + " rows");
-    if (interior_id[static_cast<std::size_t>(r)] < 0)
+    if (is_contact[static_cast<std::size_t>(r)])
       throw std::invalid_argument(kWho + "contact row " + std::to_string(r) + " listed twice");
-    interior_id[static_cast<std::size_t>(r)] = -1;
+    is_contact[static_cast<std::size_t>(r)] = 1;
   }
-  std::vector<int> interior;
+  // interior_id: the row's place among the interior rows, −1 for a contact row.
+  std::vector<int> interior_id(static_cast<std::size_t>(n), -1), interior;
   for (Eigen::Index r = 0; r < n; ++r)
-    if (interior_id[static_cast<std::size_t>(r)] == 0)
+    if (!is_contact[static_cast<std::size_t>(r)])
     {
       interior_id[static_cast<std::size_t>(r)] = static_cast<int>(interior.size());
       interior.push_back(static_cast<int>(r));
     }
-    else
-      interior_id[static_cast<std::size_t>(r)] = -1;
 
   const auto ni = static_cast<Eigen::Index>(interior.size());
   std::vector<Eigen::Triplet<double>> pattern;
