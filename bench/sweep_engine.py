@@ -49,7 +49,7 @@ dt = sweep_time_step_s([base] + variants)
 def monolithic(s):
     t0 = time.perf_counter()
     r1 = solve_stage1(s, comm=comm)
-    r2 = solve_stage2(s, r1, dt_s=dt, comm=comm)
+    r2 = solve_stage2(s, r1, dt_s=dt)
     return time.perf_counter() - t0, r1, r2
 
 

@@ -248,7 +248,7 @@ if not args.stage1_only:
     duration = args.duration or response_duration_s(s)
     with fc.ResultWriter(folder, "impact", msh, tags=(cells,)) as xdmf:
         stage2 = solve_stage2(s, stage1, dt_s=args.dt, offset_m=args.impact_offset,
-                              duration_s=duration, writer=xdmf, comm=comm,
+                              duration_s=duration, writer=xdmf,
                               contact_operator=args.contact_operator)
     p2, met = stage2.problem, stage2.metrics
     records = p2.records

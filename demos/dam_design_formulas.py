@@ -95,7 +95,7 @@ def impact(s, stage1, gap, round_trips=3.0):
     crushed area grows."""
     approach = approach_time_s(s) * gap / s.log_gap_m
     duration = approach + round_trips * default_time_step_s(s, steps_in_contact=1)
-    r = solve_stage2(s, stage1, duration_s=duration, stress_every=10**9, comm=comm)
+    r = solve_stage2(s, stage1, duration_s=duration, stress_every=10**9)
     return r, duration
 
 

@@ -28,7 +28,7 @@ def runs():
     r1 = solve_stage1(CRUSHING, comm=COMM)
     out = {}
     for name, s in (("elastic", ELASTIC), ("crushing", CRUSHING)):
-        out[name] = solve_stage2(s, r1, dt_s=dt, duration_s=response_duration_s(s), comm=COMM)
+        out[name] = solve_stage2(s, r1, dt_s=dt, duration_s=response_duration_s(s))
     return dt, r1, out
 
 

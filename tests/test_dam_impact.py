@@ -17,7 +17,7 @@ COMM = MPI.COMM_WORLD
 def impact():
     s = DamScenario()
     stage1 = solve_stage1(s, comm=COMM)
-    return s, solve_stage2(s, stage1, comm=COMM), stage1
+    return s, solve_stage2(s, stage1), stage1
 
 
 def test_impulse_equals_the_logs_momentum_change(impact):
@@ -141,7 +141,7 @@ def test_westergaard_adds_seven_twelfths_rho_h_squared_and_keeps_momentum(impact
     added = _x_mass(p_w) - _x_mass(r.problem)
     ref = 7.0 / 12.0 * s.water_density_kg_m3 * s.water_level_m ** 2
     assert abs(added / ref - 1.0) <= 1e-5, (added, ref)
-    rw = solve_stage2(sw, stage1, dt_s=dt, comm=COMM)
+    rw = solve_stage2(sw, stage1, dt_s=dt)
     dp = rw.log_momentum_change
     assert abs(rw.metrics["impulse"] - abs(dp)) <= 0.01 * abs(dp)
     assert abs(rw.metrics["peak_force"] / r.metrics["peak_force"] - 1.0) <= 0.01
@@ -151,7 +151,7 @@ def test_factor_path_gives_the_dense_answer(impact):
     """The log/dam impact through the factor of Ŵ (no dense F̂, docs/impact.md): the same
     force history as the dense path, step by step, to 1e-9 of the peak."""
     s, r, stage1 = impact
-    f = solve_stage2(s, stage1, comm=COMM, contact_operator="factor")
+    f = solve_stage2(s, stage1, contact_operator="factor")
     force_d = np.array([x.normal_force for x in r.problem.records])
     force_f = np.array([x.normal_force for x in f.problem.records])
     assert force_d.shape == force_f.shape and force_d.max() > 0

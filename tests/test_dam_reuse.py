@@ -33,8 +33,7 @@ def both(evaluator):
     """The base scenario through the evaluator and through the monolithic stages 1 + 2."""
     out = evaluator.evaluate(BASE)
     r1 = solve_stage1(BASE, comm=COMM)
-    r2 = solve_stage2(BASE, r1, dt_s=evaluator.dt, duration_s=response_duration_s(BASE),
-                      comm=COMM)
+    r2 = solve_stage2(BASE, r1, dt_s=evaluator.dt, duration_s=response_duration_s(BASE))
     return out, r1, r2
 
 

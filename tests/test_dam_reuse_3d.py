@@ -58,7 +58,7 @@ def monolithic_on_the_same_meshes(evaluator, s) -> dict:
                                   lambda x: c[None, :] + x @ R.T)]))
     r1 = solve_stage1(s, mesh=mesh, comm=COMM)
     n = run_steps(s, evaluator.dam)
-    r2 = solve_stage2(s, r1, dt_s=evaluator.dt, duration_s=n * evaluator.dt, comm=COMM)
+    r2 = solve_stage2(s, r1, dt_s=evaluator.dt, duration_s=n * evaluator.dt)
     m = r2.metrics
     heel = max(r1.section.sigma_heel_Pa, r2.section_extremes()["sigma_heel_max_Pa"])
     return {"impulse_N_s_per_m": m["impulse"], "peak_force_N_per_m": m["peak_force"],

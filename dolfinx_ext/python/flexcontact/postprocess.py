@@ -104,7 +104,7 @@ def record_increment(out: Optional[dict], number: int, u, comm, dim: int,
     return IncrementResult(summary, e, e, np.zeros(0, int), e[:, 1:], e)
 
 
-def _nodal_contact(inc: IncrementResult, pairs):
+def nodal_contact(inc: IncrementResult, pairs):
     """Pressure, tangential traction (global axes) and status (states.py: OPEN, STICK, SLIP,
     CRUSH) at every contact node: a slave node carries its pair's force over its tributary measure,
     a master node the equal and opposite forces Σ_k w_kj (…) of the pairs that use it."""
@@ -150,13 +150,15 @@ class ContactFields:
         if stress is not None:
             self.von_mises = dolfinx.fem.Function(compat.scalar_space(msh, "DG", 0),
                                                   name="von_mises")
-            self._stress_expr = stress(self.u)
+            # Compiled once: an Expression per write costs more than the interpolation.
+            self._stress_expr = dolfinx.fem.Expression(
+                stress(self.u), compat.interpolation_points(self.von_mises.function_space))
 
     def write_back(self, inc: IncrementResult, pairs: Optional[NodePairs]) -> None:
         """Contact fields of an increment at the slave and master nodes (collective)."""
         d = self.dim
         if self.comm.rank == 0:
-            pressure, trac, status = _nodal_contact(inc, pairs)
+            pressure, trac, status = nodal_contact(inc, pairs)
             real = pairs.dofs[:, 0] >= 0          # rigid targets' reference nodes: no DOFs
             dofs_v = pairs.dofs[real]
             blocks = dofs_v[:, :1] // d
@@ -170,7 +172,7 @@ class ContactFields:
         set_nodal_values(self.status, blocks, status)
         set_nodal_values(self.traction, dofs_v, trac)
         if self.von_mises is not None:
-            compat.interpolate_expression(self.von_mises, self._stress_expr)
+            self.von_mises.interpolate(self._stress_expr)
 
     def all(self) -> list:
         """The Functions, in the order ResultWriter writes them."""

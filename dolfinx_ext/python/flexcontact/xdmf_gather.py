@@ -59,6 +59,7 @@ class MeshGather:
                        f"cell; only affine (degree 1) geometry is written")
         raise_on_any_rank(self.comm, message)
         self.topology_type, perm = TOPOLOGY_TYPES[name]
+        self._positions = {}  # center -> (ids, positions) last placed and checked
         tdim = msh.topology.dim
         self.n_owned_cells = msh.topology.index_map(tdim).size_local
         self.node_ids = compat.input_node_indices(msh)
@@ -133,11 +134,19 @@ class MeshGather:
     def _place(self, name: str, center: str, parts) -> Field:
         ids = np.concatenate([p[0] for p in parts])
         values = np.concatenate([p[1] for p in parts]).astype(np.float64)
-        pos = self._cell_positions(ids) if center == "Cell" else np.searchsorted(self.nodes, ids)
         n = len(self.cell_order) if center == "Cell" else len(self.nodes)
-        if len(pos) != n or len(np.unique(pos)) != n:
-            raise SolveError(f"ResultWriter: field '{name}' has {len(np.unique(pos))} "
-                               f"owned values for {n} entities")
+        # Every field of a space arrives in the same order: its positions, found and
+        # checked once, serve every later write (the search costs more than the copy).
+        known = self._positions.get(center)
+        if known is not None and np.array_equal(known[0], ids):
+            pos = known[1]
+        else:
+            pos = (self._cell_positions(ids) if center == "Cell"
+                   else np.searchsorted(self.nodes, ids))
+            if len(pos) != n or len(np.unique(pos)) != n:
+                raise SolveError(f"ResultWriter: field '{name}' has {len(np.unique(pos))} "
+                                   f"owned values for {n} entities")
+            self._positions[center] = (ids, pos)
         full = np.empty((n, values.shape[1]))
         full[pos] = values
         if full.shape[1] == 2:  # 2D vectors as 3D ones (z = 0), as ParaView's Warp By Vector wants

@@ -28,7 +28,7 @@ from .. import _cpp
 from ..condensation import kernel_pairs
 from ..pairing import pair_caps
 from ..impact_output import contact_metrics
-from ..postprocess import _nodal_contact
+from ..postprocess import nodal_contact
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .log_model import rotation
@@ -275,7 +275,7 @@ def _peak_pressure(out: dict, pairs, h: float) -> float:
     tributary measure, slaves and masters, as ContactFields writes it."""
     inc = SimpleNamespace(lam=np.asarray(out["impulse"]) / h, states=np.asarray(out["states"]),
                           tangential=np.asarray(out["pair_tangential"]) / h)
-    pressure, _, _ = _nodal_contact(inc, pairs)
+    pressure, _, _ = nodal_contact(inc, pairs)
     return float(pressure.max(initial=0.0))
 
 

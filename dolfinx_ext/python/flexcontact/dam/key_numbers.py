@@ -121,7 +121,7 @@ def mesh_study_row(s, impact_offset_m: float, duration_s=None, comm=None,
     comm = comm or MPI.COMM_WORLD
     stage1 = solve_stage1(s, comm=comm)
     stage2 = solve_stage2(s, stage1, offset_m=impact_offset_m, duration_s=duration_s,
-                          comm=comm, contact_operator=contact_operator)
+                          contact_operator=contact_operator)
     from ..output import mesh_info
     row = engineer_numbers(s, stage1, stage2)
     size = mesh_info(stage1.V)

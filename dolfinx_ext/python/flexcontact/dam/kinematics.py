@@ -49,41 +49,61 @@ class LogKinematics:
         self.u, self.name, self.comm = u, name, msh.comm
         self.dim = msh.geometry.dim
         dx = ufl.Measure("dx", domain=msh, subdomain_data=cell_tags)(tag)
-        g = ufl.grad(u)
-        skew = 0.5 * (g - g.T)
-        # The rotation vector's components (2D: the one about z).
-        comps = [skew[1, 0]] if self.dim == 2 else [skew[2, 1], skew[0, 2], skew[1, 0]]
-        self._rot = [dolfinx.fem.form(c * dx) for c in comps]
-        self._vol = dolfinx.fem.form(dolfinx.fem.Constant(msh, 1.0) * dx)
         n_owned = msh.topology.index_map(msh.topology.dim).size_local
         cells = cell_tags.indices[cell_tags.values == tag]
         self._cells = cells[cells < n_owned].astype(np.int32)
+        # ∇u of P1 is constant per cell: one evaluation per cell gives both the rotation
+        # (its skew part times the cell's volume) and the strain (its symmetric part).
         point = np.full((1, msh.topology.dim), 1.0 / (msh.topology.dim + 1))
-        self._strain = dolfinx.fem.Expression(ufl.sym(g), point)
+        self._grad = dolfinx.fem.Expression(ufl.grad(u), point)
         self._msh = msh
-        self.volume = self.comm.allreduce(dolfinx.fem.assemble_scalar(self._vol), op=MPI.SUM)
+        V0 = compat.scalar_space(msh, "DG", 0)
+        volumes = compat.assemble_vector_array(dolfinx.fem.form(ufl.TestFunction(V0) * dx))
+        self._cell_volume = volumes[compat.cell_dofs(V0)[self._cells, 0]]
+        self.volume = self.comm.allreduce(float(self._cell_volume.sum()), op=MPI.SUM)
         self.max_rotation_rad = 0.0
         self.max_strain = 0.0
 
-    def rotation_rad(self) -> float:
-        """Magnitude of the mean infinitesimal rotation of the body (rad). Collective."""
-        comps = [self.comm.allreduce(dolfinx.fem.assemble_scalar(f), op=MPI.SUM)
-                 for f in self._rot]
-        return float(np.linalg.norm(comps)) / self.volume
+    def _gradients(self) -> np.ndarray:
+        """∇u on this rank's owned cells of the body, (cells, dim, dim)."""
+        if not len(self._cells):
+            return np.zeros((0, self.dim, self.dim))
+        g = compat.eval_expression(self._grad, self._msh, self._cells)
+        return np.asarray(g).reshape(len(self._cells), self.dim, self.dim)
 
-    def largest_strain(self) -> float:
-        """Largest |principal strain| over the body's cells. Collective."""
+    def rotation_rad(self, g: np.ndarray | None = None) -> float:
+        """Magnitude of the mean infinitesimal rotation of the body (rad), from the
+        gradients ``g`` of :meth:`_gradients` if given. Collective."""
+        g = self._gradients() if g is None else g
+        skew = 0.5 * (g - np.transpose(g, (0, 2, 1)))
+        # The rotation vector's components (2D: the one about z).
+        comps = (skew[:, [1], [0]] if self.dim == 2
+                 else np.column_stack([skew[:, 2, 1], skew[:, 0, 2], skew[:, 1, 0]]))
+        local = self._cell_volume @ comps
+        return float(np.linalg.norm(self.comm.allreduce(local, op=MPI.SUM))) / self.volume
+
+    def largest_strain(self, g: np.ndarray | None = None) -> float:
+        """Largest |principal strain| over the body's cells, from the gradients ``g`` of
+        :meth:`_gradients` if given. Collective.
+
+        A symmetric tensor's largest |eigenvalue| lies between its Frobenius norm / √dim
+        and its Frobenius norm, so only the cells whose norm reaches the largest norm / √dim
+        can hold the largest one: the eigenvalues are computed on those alone."""
+        g = self._gradients() if g is None else g
         best = 0.0
-        if len(self._cells):
-            e = compat.eval_expression(self._strain, self._msh, self._cells)
-            e = np.asarray(e).reshape(len(self._cells), self.dim, self.dim)
-            best = float(np.abs(np.linalg.eigvalsh(e)).max())
+        if len(g):
+            e = 0.5 * (g + np.transpose(g, (0, 2, 1)))
+            frob = np.sqrt(np.einsum("cij,cij->c", e, e))
+            # A relative margin keeps a cell whose rounded norm sits at the bound.
+            bound = frob.max() / np.sqrt(self.dim) * (1.0 - 1e-12)
+            best = float(np.abs(np.linalg.eigvalsh(e[frob >= bound])).max())
         return self.comm.allreduce(best, op=MPI.MAX)
 
     def measure(self, t_s: float) -> tuple[float, float]:
         """Measure now, keep the maxima and warn (once per quantity) when a limit is passed.
         Returns (rotation in rad, largest principal strain). Collective."""
-        rot, strain = self.rotation_rad(), self.largest_strain()
+        g = self._gradients()
+        rot, strain = self.rotation_rad(g), self.largest_strain(g)
         if rot > ROTATION_LIMIT_RAD >= self.max_rotation_rad:
             warnings.warn(
                 f"{self.name}: rigid rotation {rot:.4g} rad at t = {t_s:.6g} s exceeds the "

@@ -96,36 +96,49 @@ class BaseSection:
 def nodal_forces(V, form, facet_tags=None, tag=None) -> tuple[np.ndarray, np.ndarray]:
     """Assemble the linear ``form`` and return this rank's owned nodal forces (n, gdim) and
     their points (n, gdim), on the nodes of facets tagged ``tag`` (all nodes if None)."""
-    import dolfinx.fem
-    import dolfinx.fem.petsc
-    msh = V.mesh
-    r = compat.create_petsc_vector(V)
-    r.zeroEntries()
-    dolfinx.fem.petsc.assemble_vector(r, form)
-    r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    n_owned = V.dofmap.index_map.size_local
-    if tag is None:
-        owned = np.arange(n_owned, dtype=np.int32)
-    else:
-        facets = facet_tags.indices[facet_tags.values == tag]
-        blocks = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim - 1, facets)
-        owned = blocks[blocks < n_owned]
-    gdim = msh.geometry.dim
-    values = r.array_r.reshape(-1, gdim)[owned].copy()
-    r.destroy()
-    return V.tabulate_dof_coordinates()[owned, :gdim], values
+    return NodalForces(V, facet_tags, tag)(form)
+
+
+class NodalForces:
+    """:func:`nodal_forces` with the nodes and their points found once, for a form assembled
+    at every time step. Collective, as is a call."""
+
+    def __init__(self, V, facet_tags=None, tag=None):
+        import dolfinx.fem
+        msh = V.mesh
+        self.V, self.gdim = V, msh.geometry.dim
+        n_owned = V.dofmap.index_map.size_local
+        if tag is None:
+            self.owned = np.arange(n_owned, dtype=np.int32)
+        else:
+            facets = facet_tags.indices[facet_tags.values == tag]
+            blocks = dolfinx.fem.locate_dofs_topological(V, msh.topology.dim - 1, facets)
+            self.owned = blocks[blocks < n_owned]
+        self.points = V.tabulate_dof_coordinates()[self.owned, :self.gdim]
+
+    def __call__(self, form) -> tuple[np.ndarray, np.ndarray]:
+        import dolfinx.fem.petsc
+        r = compat.create_petsc_vector(self.V)
+        r.zeroEntries()
+        dolfinx.fem.petsc.assemble_vector(r, form)
+        r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        values = r.array_r.reshape(-1, self.gdim)[self.owned].copy()
+        r.destroy()
+        return self.points, values
 
 
 def nodal_section(V, residual_form, facet_tags, base_tag: int, base_width_m: float,
-                  width_m: float = 1.0) -> BaseSection:
+                  width_m: float = 1.0, nodes: "NodalForces | None" = None) -> BaseSection:
     """Base section from the nodal forces of one side's residual at the base nodes.
 
     ``residual_form``: compiled linear form L_side(v) − a_side(u_h, v) of the dam's free body
     (loads minus internal forces over the dam's cells only). Its value at a base node is the
     force the dam hands to the foundation there, and elsewhere it vanishes; the sums are
-    those of the loads on the dam, exact in statics whatever the mesh. Collective.
+    those of the loads on the dam, exact in statics whatever the mesh. ``nodes``: the base
+    nodes as a :class:`NodalForces` of the same V and tag, found once. Collective.
     """
-    points, values = nodal_forces(V, residual_form, facet_tags, base_tag)
+    nodes = nodes or NodalForces(V, facet_tags, base_tag)
+    points, values = nodes(residual_form)
     return BaseSection.from_forces(points, values, base_width_m, width_m, comm=V.mesh.comm)
 
 
@@ -148,18 +161,47 @@ def peak_at_offset(f, point, offset_m: float, cell_tags=None, tag=None, samples:
     (and inside cells tagged ``tag`` if given) and returns ``(value, where)``: the maximum
     and the sample point (3 coordinates), or ``(nan, None)`` if no sample lies in the body.
     Stresses at a re-entrant corner or under a contact edge grow with mesh refinement; at a
-    stated distance they converge, which is what a design check can use. Collective.
+    stated distance they converge, which is what a design check can use. Collective. To
+    sample the same sphere at every time step, make an :class:`OffsetProbe` once.
     """
-    msh = f.function_space.mesh
-    pts, found, cells = offset_samples(msh, point, offset_m, cell_tags, tag, samples)
-    best, where = -np.inf, None
-    if len(found):
-        vals = f.eval(pts[found], cells).reshape(-1)
-        i = int(np.argmax(vals))
-        best, where = float(vals[i]), pts[found[i]]
-    everyone = msh.comm.allgather((best, where))
-    best, where = max(everyone, key=lambda bw: bw[0])
-    return (best, where) if np.isfinite(best) else (float("nan"), None)
+    probe = OffsetProbe(f.function_space.mesh, point, offset_m, cell_tags, tag, samples)
+    return probe.peak(f)
+
+
+class OffsetProbe:
+    """The samples of :func:`peak_at_offset`, located in the mesh once: finding them builds a
+    bounding-box tree of the whole mesh, which costs far more than reading a field there,
+    and a linear run's mesh does not move. Collective, as are its methods."""
+
+    def __init__(self, msh, point, offset_m: float, cell_tags=None, tag=None,
+                 samples: int = 720):
+        self.comm = msh.comm
+        self.points, self.found, cells = offset_samples(msh, point, offset_m, cell_tags, tag,
+                                                        samples)
+        self.cells, self._of_sample = np.unique(cells, return_inverse=True)
+        self.cells = self.cells.astype(np.int32)
+
+    def peak(self, f):
+        """(largest value of the Function ``f`` over the samples, its sample point)."""
+        vals = np.zeros(0)
+        if len(self.found):
+            vals = f.eval(self.points[self.found], self.cells[self._of_sample]).reshape(-1)
+        return self._best(vals)
+
+    def peak_cellwise(self, cell_values):
+        """As :meth:`peak` for a cell-wise constant field given by its values on
+        :attr:`cells` (in that order): a DG0 field evaluated at a point is its cell's value,
+        so only these cells need computing."""
+        return self._best(np.asarray(cell_values, dtype=float).reshape(-1)[self._of_sample])
+
+    def _best(self, vals):
+        best, where = -np.inf, None
+        if len(vals):
+            i = int(np.argmax(vals))
+            best, where = float(vals[i]), self.points[self.found[i]]
+        everyone = self.comm.allgather((best, where))
+        best, where = max(everyone, key=lambda bw: bw[0])
+        return (best, where) if np.isfinite(best) else (float("nan"), None)
 
 
 def offset_samples(msh, point, offset_m: float, cell_tags=None, tag=None, samples: int = 720):

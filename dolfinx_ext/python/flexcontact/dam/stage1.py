@@ -182,11 +182,13 @@ def section_form(s, V, u, loads, dx, kind):
     return dolfinx.fem.form(loads["dam"] - elasticity_form(u, v, s.concrete, dx(T.DAM), kind))
 
 
-def dam_section(s, V, residual_form, mesh: DamMesh) -> BaseSection:
+def dam_section(s, V, residual_form, mesh: DamMesh, nodes=None) -> BaseSection:
     """The base section from a compiled residual (:func:`section_form`), the uplift
-    resultant added. Collective."""
+    resultant added; ``nodes``: the base's section.NodalForces, found once for a form
+    assembled at every step. Collective."""
     w = 1.0 if s.dim == 2 else s.dam_width_m
-    sec = nodal_section(V, residual_form, mesh.facet_tags, T.DAM_BASE, s.base_width_m, w)
+    sec = nodal_section(V, residual_form, mesh.facet_tags, T.DAM_BASE, s.base_width_m, w,
+                        nodes)
     if s.uplift_factor > 0:
         force, at = uplift_resultant(s)
         up = np.zeros(s.dim)

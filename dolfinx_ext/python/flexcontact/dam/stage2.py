@@ -50,7 +50,7 @@ from ..meshes import dam_tags as T
 from ..problem import ContactInterface
 from .fields import StressFields
 from .kinematics import LogKinematics
-from .section import peak_at_offset
+from .section import NodalForces, OffsetProbe
 from .stage1 import _measures, body_loads, dam_section, section_form
 from ..errors import InputError
 
@@ -200,7 +200,7 @@ def westergaard_form(s, mesh):
 def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
                  duration_s: Optional[float] = None, offset_m: float = 1.0,
                  writer=None, write_every: int = 5, stress_every: int = 1,
-                 comm=MPI.COMM_WORLD, contact_operator: str = "dense") -> Stage2Result:
+                 contact_operator: str = "dense") -> Stage2Result:
     """Run the impact from ``stage1`` (a Stage1Result of the same scenario). Collective.
 
     ``dt_s``: time step (default :func:`default_time_step_s`); ``duration_s``: simulated
@@ -236,6 +236,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
 
     fields = StressFields(stage1.V, problem.u, cells, materials, stage1.kind)
     stresses = fields.update
+    probe = OffsetProbe(stage1.mesh.msh, impact, offset_m, cells, T.DAM)
 
     n = int(round(duration_s / dt))
     if writer is not None:
@@ -246,10 +247,10 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
         if writer is not None and (i + 1) % write_every == 0:
             writer.write(problem.fields() + stresses(), problem.t)
         if rec.active > 0 and (i % stress_every == 0):
-            peak, _ = peak_at_offset(stresses()[1], impact, offset_m, cells, T.DAM)
+            principal = fields.on_cells("max_principal_stress_Pa", probe.cells)
+            peak, _ = probe.peak_cellwise(principal)
             history.append((problem.t, peak))
-            pressure = problem.fields()[2].x.array
-            p_peak = max(p_peak, comm.allreduce(float(pressure.max(initial=0.0)), op=MPI.MAX))
+            p_peak = max(p_peak, problem.peak_contact_pressure_Pa())
     metrics = contact_metrics(problem.records, dt, filter_window_s=force_filter_window_s(s))
     m_eff, v0, v1 = _log_momentum(problem)
     return Stage2Result(problem, metrics, m_eff * (v1 - v0), m_eff, v0, v1, history, impact,
@@ -270,7 +271,8 @@ class _Watch:
         self.s, self.V, self.mesh, self.problem = s, stage1.V, stage1.mesh, problem
         self.form = section_form(s, stage1.V, problem.u, body_loads(s, v, dx, ds),
                                  dx, stage1.kind)
-        self.sections = [(0.0, dam_section(s, stage1.V, self.form, stage1.mesh))]
+        self.base = NodalForces(stage1.V, stage1.mesh.facet_tags, T.DAM_BASE)
+        self.sections = [(0.0, dam_section(s, stage1.V, self.form, stage1.mesh, self.base))]
         self.log = LogKinematics(problem.u, stage1.mesh.cell_tags, T.LOG)
         self.peak_u = dolfinx.fem.Function(stage1.V, name="displacement_m")
         self.peak_u.x.array[:] = problem.u.x.array
@@ -278,7 +280,7 @@ class _Watch:
 
     def after_step(self, rec) -> None:
         t = self.problem.t
-        self.sections.append((t, dam_section(self.s, self.V, self.form, self.mesh)))
+        self.sections.append((t, dam_section(self.s, self.V, self.form, self.mesh, self.base)))
         self.log.measure(t)
         if rec.normal_force > self.peak_force:
             self.peak_force, self.peak_t = rec.normal_force, t

@@ -62,7 +62,7 @@ class MonolithicEvaluator:
         stage1 = solve_stage1(scenario, comm=self.comm)
         self._add("stage1", 1, 1)
         st2 = solve_stage2(scenario, stage1, dt_s=self.dt_s, offset_m=IMPACT_OFFSET_M,
-                           duration_s=response_duration_s(scenario), comm=self.comm)
+                           duration_s=response_duration_s(scenario))
         t_out = time.perf_counter()
         p = st2.problem
         self._add("stage2", getattr(p.condensation, "factorizations", 1),
