@@ -64,7 +64,7 @@ class LogKinematics:
         self.max_rotation_rad = 0.0
         self.max_strain = 0.0
 
-    def _gradients(self) -> np.ndarray:
+    def gradients(self) -> np.ndarray:
         """∇u on this rank's owned cells of the body, (cells, dim, dim)."""
         if not len(self._cells):
             return np.zeros((0, self.dim, self.dim))
@@ -73,8 +73,8 @@ class LogKinematics:
 
     def rotation_rad(self, g: np.ndarray | None = None) -> float:
         """Magnitude of the mean infinitesimal rotation of the body (rad), from the
-        gradients ``g`` of :meth:`_gradients` if given. Collective."""
-        g = self._gradients() if g is None else g
+        gradients ``g`` of :meth:`gradients` if given. Collective."""
+        g = self.gradients() if g is None else g
         skew = 0.5 * (g - np.transpose(g, (0, 2, 1)))
         # The rotation vector's components (2D: the one about z).
         comps = (skew[:, [1], [0]] if self.dim == 2
@@ -84,12 +84,12 @@ class LogKinematics:
 
     def largest_strain(self, g: np.ndarray | None = None) -> float:
         """Largest |principal strain| over the body's cells, from the gradients ``g`` of
-        :meth:`_gradients` if given. Collective.
+        :meth:`gradients` if given. Collective.
 
         A symmetric tensor's largest |eigenvalue| lies between its Frobenius norm / √dim
         and its Frobenius norm, so only the cells whose norm reaches the largest norm / √dim
         can hold the largest one: the eigenvalues are computed on those alone."""
-        g = self._gradients() if g is None else g
+        g = self.gradients() if g is None else g
         best = 0.0
         if len(g):
             e = 0.5 * (g + np.transpose(g, (0, 2, 1)))
@@ -102,7 +102,7 @@ class LogKinematics:
     def measure(self, t_s: float) -> tuple[float, float]:
         """Measure now, keep the maxima and warn (once per quantity) when a limit is passed.
         Returns (rotation in rad, largest principal strain). Collective."""
-        g = self._gradients()
+        g = self.gradients()
         rot, strain = self.rotation_rad(g), self.largest_strain(g)
         if rot > ROTATION_LIMIT_RAD >= self.max_rotation_rad:
             warnings.warn(

@@ -68,8 +68,8 @@ default log (10 m × Ø0.8 m, 10° pitch, 2 m/s, flat end, σ_c = 26.1 MPa) at t
 at least four elements: the main job's. Measured: in 2D the patch is about 5 cm along the
 end (9 crushing nodes at 6.25 mm); the filtered peak force 1.79, 1.62, 1.43, 1.38, 1.37 MN/m
 at 50, 25, 12.5, 6.25, 3.1 mm. In 3D the patch is a segment of the end, up to 210 pairs at
-their cap at 12.5 mm within the 0.35 m ball; the filtered peak force 0.713 MN at 12.5 mm and
-0.748 MN at 25 mm (far 6 m, impact 0.4 m; docs/dam.md, design formulas). In 3D the ball
+their cap at 12.5 mm within the 0.35 m ball; the filtered peak force 0.718 MN at 12.5 mm and
+0.764 MN at 25 mm (far 6 m, impact 0.4 m; docs/dam.md, design formulas). In 3D the ball
 refines the log only (meshes/dam.py)."""
 
 
