@@ -34,7 +34,7 @@ from mpi4py import MPI
 
 from .. import saved_factor
 from ..split_factor import SplitFactor
-from ..errors import InputError, SavedFileError
+from ..errors import SavedFileError
 
 MODEL_FORMAT = 2
 """The model directory's format: a model of another format is refused (2: a factor may be

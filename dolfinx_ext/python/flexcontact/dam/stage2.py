@@ -41,7 +41,6 @@ from mpi4py import MPI
 
 import dolfinx.fem
 
-from .. import impact_setup
 from ..boundary import dirichlet
 from ..dynamics import ImpactProblem
 from ..forms import Material
