@@ -43,7 +43,7 @@ from .factor_path import FactorImpactCondensation
 from .names import (CONTACT_OPERATORS, ContactOperator, check_chain, check_flexibility_method,
                     check_option, check_ordering)
 from .pairing import pair_interfaces
-from .postprocess import ContactFields, nodal_contact
+from .postprocess import ContactFields, impact_step_forces, peak_pressure_Pa
 from .states import CRUSH, OPEN, SLIP, STICK
 from .stepper import Stepper, StepperViews
 from .errors import InputError
@@ -443,10 +443,7 @@ class ImpactProblem(StepperViews):
     def peak_contact_pressure_Pa(self) -> float:
         """The largest value of :meth:`fields`' contact pressure (Pa, 0 without contact),
         without writing any field: cheap enough for every step. Collective."""
-        best = 0.0
-        if self.comm.rank == 0:
-            pressure = nodal_contact(self._last_increment(), self.pairs)[0]
-            best = float(pressure[self.pairs.dofs[:, 0] >= 0].max(initial=0.0))
+        best = peak_pressure_Pa(self._last_increment(), self.pairs) if self.comm.rank == 0 else 0.0
         return self.comm.bcast(best, root=0)
 
     def _last_increment(self):
@@ -455,8 +452,7 @@ class ImpactProblem(StepperViews):
         from types import SimpleNamespace
         d, out = self.dim, self._last_out
         if self.comm.rank == 0 and out is not None:
-            return SimpleNamespace(lam=out["impulse"] / self.dt, states=out["states"],
-                                   tangential=out["pair_tangential"] / self.dt)
+            return impact_step_forces(out, self.dt)
         m = self.m if self.comm.rank == 0 else 0
         return SimpleNamespace(lam=np.zeros((m, d)), states=np.full(m, OPEN),
                                tangential=np.zeros((m, d)))

@@ -126,6 +126,22 @@ def nodal_contact(inc: IncrementResult, pairs):
     return force_n / area, force_t / area[:, None], state
 
 
+def impact_step_forces(out: dict, h: float):
+    """An impact step's kernel output as :func:`nodal_contact` reads an increment: the pair
+    forces as the step's mean (impulse / h), with their states."""
+    from types import SimpleNamespace
+    return SimpleNamespace(lam=np.asarray(out["impulse"]) / h, states=np.asarray(out["states"]),
+                           tangential=np.asarray(out["pair_tangential"]) / h)
+
+
+def peak_pressure_Pa(inc, pairs) -> float:
+    """The largest nodal contact pressure of :func:`nodal_contact` (Pa, 0 without contact),
+    over the nodes that carry DOFs (not rigid targets' reference nodes), as
+    ContactFields.write_back sets it."""
+    pressure = nodal_contact(inc, pairs)[0]
+    return float(pressure[pairs.dofs[:, 0] >= 0].max(initial=0.0))
+
+
 class ContactFields:
     """The output Functions: displacement, contact pressure, tangential traction, status
     (1 open, 2 stick, 3 slip, 4 crush) and, if ``stress`` is given (u -> UFL scalar), a DG0 stress."""

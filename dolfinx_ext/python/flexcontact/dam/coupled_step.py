@@ -28,7 +28,7 @@ from .. import _cpp
 from ..condensation import kernel_pairs
 from ..pairing import pair_caps
 from ..impact_output import contact_metrics
-from ..postprocess import nodal_contact
+from ..postprocess import impact_step_forces, peak_pressure_Pa
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .log_model import rotation
@@ -185,7 +185,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
         if active > 0:
             touched, last_contact = True, i
             peak_principal = max(peak_principal, dam.peak_principal_Pa(static, bd.w, cells))
-            p_peak = max(p_peak, _peak_pressure(out, pairs, h))
+            p_peak = max(p_peak, peak_pressure_Pa(impact_step_forces(out, h), pairs))
         elif (after_contact == "convolve" and touched and theta == 0.5 and i + 1 < n):
             bound = np.sqrt(2.0 * max(dam.energy_J(bd.w, bd.omega), 0.0)
                             * dam.face_compliance(0))
@@ -268,15 +268,6 @@ def _log_values(log, vec, R, rigid) -> np.ndarray:
     the rigid part ``rigid`` (d,) on every node; node-major."""
     local = vec.array_r[log.front_dofs].reshape(-1, R.shape[0])
     return (local @ R.T + rigid[None, :]).reshape(-1)
-
-
-def _peak_pressure(out: dict, pairs, h: float) -> float:
-    """Largest contact pressure of the step (Pa): impulse / h over each contact node's
-    tributary measure, slaves and masters, as ContactFields writes it."""
-    inc = SimpleNamespace(lam=np.asarray(out["impulse"]) / h, states=np.asarray(out["states"]),
-                          tangential=np.asarray(out["pair_tangential"]) / h)
-    pressure, _, _ = nodal_contact(inc, pairs)
-    return float(pressure.max(initial=0.0))
 
 
 def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,

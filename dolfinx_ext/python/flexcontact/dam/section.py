@@ -229,8 +229,7 @@ def offset_sample_cells(msh, point, offset_m: float, cell_tags=None, tag=None,
                         samples: int = 720) -> np.ndarray:
     """The distinct cells holding the samples of :func:`peak_at_offset`: for a cell-wise
     constant field its peak at the offset is the largest value over these cells."""
-    _, _, cells = offset_samples(msh, point, offset_m, cell_tags, tag, samples)
-    return np.unique(cells).astype(np.int32)
+    return OffsetProbe(msh, point, offset_m, cell_tags, tag, samples).cells
 
 
 def write_section_csv(path, history) -> None:
