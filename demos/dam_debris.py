@@ -227,7 +227,9 @@ if comm.rank == 0:
 # m_eff Δv from the velocities of its nodes before and after (no other force acts on the
 # log, so they agree to round-off); the largest principal stress in the dam at
 # `--impact-offset` from the first-contact point (the corner's own stress grows with
-# refinement), and the peak contact pressure (mean over a step and a node's tributary
+# refinement), read from the recovered (nodal-average) stress, with Boussinesq's
+# half-space value beside it in 3D, where the face's tension lies in a layer thinner
+# than the elements; and the peak contact pressure (mean over a step and a node's tributary
 # length: mesh-dependent at a corner contact) against the wood's crushing strength.
 #
 # What engineers use: the base section's force and moment at every step, from the dam's
@@ -291,7 +293,10 @@ if not args.stage1_only:
               f"{met['contact_duration_s'] * 1e3:.3f} ms, impulse {met['impulse']:.6e} "
               f"(log m_eff dv {-stage2.log_momentum_change:.6e}); peak principal stress "
               f"{args.impact_offset} m from the impact "
-              f"{stage2.peak_tensile_stress_Pa / 1e6:.3f} MPa")
+              f"{stage2.peak_tensile_stress_Pa / 1e6:.3f} MPa"
+              + ("" if numbers["halfspace_tension_at_offset_Pa"] is None else
+                 f" (Boussinesq's half-space value for the normal force "
+                 f"{numbers['halfspace_tension_at_offset_Pa'] / 1e6:.3f} MPa)"))
         print(f"linearised heel stress {numbers['sigma_heel_before_Pa'] / 1e6:.4f} MPa before, "
               f"up to {numbers['sigma_heel_during_max_Pa'] / 1e6:.4f} MPa during the impact")
 

@@ -37,12 +37,13 @@ def cpp(obj):
     return getattr(obj, "_cpp_object", obj)
 
 
-def vector_space(msh, degree: int = 1):
-    """Continuous Lagrange vector space of the mesh's geometric dimension."""
+def vector_space(msh, degree: int = 1, size: int = None):
+    """Continuous Lagrange vector space of ``size`` components (default: the mesh's
+    geometric dimension)."""
+    size = msh.geometry.dim if size is None else int(size)
     if NEW_API:
-        gdim = msh.geometry.dim
-        return dolfinx.fem.functionspace(msh, ("Lagrange", degree, (gdim,)))
-    return dolfinx.fem.VectorFunctionSpace(msh, ("Lagrange", degree))
+        return dolfinx.fem.functionspace(msh, ("Lagrange", degree, (size,)))
+    return dolfinx.fem.VectorFunctionSpace(msh, ("Lagrange", degree), dim=size)
 
 
 def scalar_space(msh, family: str = "Lagrange", degree: int = 1):

@@ -31,6 +31,7 @@ from ..impact_output import contact_metrics
 from ..postprocess import impact_step_forces, peak_pressure_Pa
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
+from .key_numbers import halfspace_surface_tension_Pa
 from .log_model import rotation
 from .stage2 import (MARGIN, approach_time_s, force_filter_window_s, log_crushing_strength_Pa,
                      response_duration_s)
@@ -136,7 +137,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     u_face0 = static.u.x.array[dam.face_dofs]
     impact = np.array(s.log_front_point, float)
     impact[0] = 0.0  # on the face
-    cells = dam.stress_cells(impact, offset_m)
+    probe = dam.stress_probe(impact, offset_m)
     n = run_steps(s, dam)
     records, peak_principal, p_peak = [], -math.inf, 0.0
     section = {q: np.zeros(n) for q in dam.section_gradients}
@@ -184,7 +185,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
                 section[q][i] = v
         if active > 0:
             touched, last_contact = True, i
-            peak_principal = max(peak_principal, dam.peak_principal_Pa(static, bd.w, cells))
+            peak_principal = max(peak_principal, dam.peak_principal_Pa(static, bd.w, probe))
             p_peak = max(p_peak, peak_pressure_Pa(impact_step_forces(out, h), pairs))
         elif (after_contact == "convolve" and touched and theta == 0.5 and i + 1 < n):
             bound = np.sqrt(2.0 * max(dam.energy_J(bd.w, bd.omega), 0.0)
@@ -215,6 +216,13 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
         out["history"] = section
         out["face_impulses"] = impulses[:last_contact + 1]
     return out
+
+
+def _halfspace(s, force_N: float, offset_m: float) -> dict:
+    """In 3D, Boussinesq's surface tension at the offset under the filtered peak force
+    (key_numbers.halfspace_surface_tension_Pa), beside the stress read from the mesh."""
+    value = halfspace_surface_tension_Pa(s, force_N, offset_m)
+    return {} if value is None else {"halfspace_tension_Pa": value}
 
 
 def _section_outputs(static, section: dict) -> dict:
@@ -291,6 +299,7 @@ def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_pea
         "heel_stress_static_Pa": static_heel,
         "heel_stress_impact_Pa": heel,
         "peak_tensile_stress_Pa": peak_principal if math.isfinite(peak_principal) else math.nan,
+        **_halfspace(s, m["peak_force_filtered"], offset_m),
         "stress_offset_m": float(offset_m),
         "peak_contact_pressure_Pa": p_peak,
         "steps": int(n),

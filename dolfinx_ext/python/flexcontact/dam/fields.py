@@ -1,8 +1,6 @@
 """Stress fields of a dam state for output (cell-wise constant: exact for P1 displacements)."""
 from __future__ import annotations
 
-import numpy as np
-
 import dolfinx.fem
 
 from .. import compat
@@ -35,16 +33,6 @@ class StressFields:
             f.interpolate(e)
             f.x.scatter_forward()
         return self.functions
-
-    def on_cells(self, name: str, cells) -> np.ndarray:
-        """The field ``name`` (one of the Functions' names) on the given local ``cells``
-        only, as :meth:`update` would set it there: for a probe that reads a few cells at
-        every step, without computing the whole mesh."""
-        cells = np.asarray(cells, dtype=np.int32)
-        if not len(cells):
-            return np.zeros(0)
-        e = self._exprs[self._names.index(name)]
-        return np.asarray(compat.eval_expression(e, self._msh, cells)).reshape(-1)
 
 
 def stress_fields(V, u, cell_tags, materials: dict, kind: str) -> list:

@@ -180,21 +180,19 @@ class OffsetProbe:
                                                         samples)
         self.cells, self._of_sample = np.unique(cells, return_inverse=True)
         self.cells = self.cells.astype(np.int32)
+        self.sample_cells = self.cells[self._of_sample]
+        """The cell of each found sample, in the order of :attr:`found`."""
 
     def peak(self, f):
         """(largest value of the Function ``f`` over the samples, its sample point)."""
         vals = np.zeros(0)
         if len(self.found):
-            vals = f.eval(self.points[self.found], self.cells[self._of_sample]).reshape(-1)
-        return self._best(vals)
+            vals = f.eval(self.points[self.found], self.sample_cells).reshape(-1)
+        return self.best(vals)
 
-    def peak_cellwise(self, cell_values):
-        """As :meth:`peak` for a cell-wise constant field given by its values on
-        :attr:`cells` (in that order): a DG0 field evaluated at a point is its cell's value,
-        so only these cells need computing."""
-        return self._best(np.asarray(cell_values, dtype=float).reshape(-1)[self._of_sample])
-
-    def _best(self, vals):
+    def best(self, vals):
+        """(largest of ``vals``, one per found sample in order, over every rank; its sample
+        point), or (nan, None) if no rank holds a sample."""
         best, where = -np.inf, None
         if len(vals):
             i = int(np.argmax(vals))
@@ -223,13 +221,6 @@ def offset_samples(msh, point, offset_m: float, cell_tags=None, tag=None, sample
         keep = mark[cells]
         found, cells = found[keep], cells[keep]
     return pts, found, cells
-
-
-def offset_sample_cells(msh, point, offset_m: float, cell_tags=None, tag=None,
-                        samples: int = 720) -> np.ndarray:
-    """The distinct cells holding the samples of :func:`peak_at_offset`: for a cell-wise
-    constant field its peak at the offset is the largest value over these cells."""
-    return OffsetProbe(msh, point, offset_m, cell_tags, tag, samples).cells
 
 
 def write_section_csv(path, history) -> None:

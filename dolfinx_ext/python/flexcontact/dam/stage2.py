@@ -49,7 +49,8 @@ from ..meshes import dam_tags as T
 from ..problem import ContactInterface
 from .fields import StressFields
 from .kinematics import LogKinematics
-from .section import NodalForces, OffsetProbe
+from .section import NodalForces
+from .stress_probe import RecoveredStressProbe
 from .stage1 import _measures, body_loads, dam_section, section_form
 from ..errors import InputError
 
@@ -203,11 +204,12 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     """Run the impact from ``stage1`` (a Stage1Result of the same scenario). Collective.
 
     ``dt_s``: time step (default :func:`default_time_step_s`); ``duration_s``: simulated
-    time (default: the approach gap / (speed · x) plus MARGIN × 2L/c of the log); ``offset_m``: the
-    distance from the first-contact point on the face at which the largest principal
-    stress in the dam is sampled every ``stress_every`` steps in contact; ``writer``: a
-    ResultWriter receiving the ImpactProblem's fields every ``write_every`` steps;
-    ``contact_operator``: as for :func:`make_problem`.
+    time (default: the approach gap / (speed · x) plus MARGIN × 2L/c of the log);
+    ``offset_m``: the distance from the first-contact point on the face at which the
+    largest principal stress in the dam (recovered, see :class:`RecoveredStressProbe`) is
+    sampled every ``stress_every`` steps in contact; ``writer``: a ResultWriter receiving
+    the ImpactProblem's fields every ``write_every`` steps; ``contact_operator``: as for
+    :func:`make_problem`.
 
     Besides the contact metrics the result holds, for every step, the base section from
     the dam's displacement (``section_history``), the log's largest rigid rotation and
@@ -235,7 +237,8 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
 
     fields = StressFields(stage1.V, problem.u, cells, materials, stage1.kind)
     stresses = fields.update
-    probe = OffsetProbe(stage1.mesh.msh, impact, offset_m, cells, T.DAM)
+    probe = RecoveredStressProbe(problem.u, cells, materials, stage1.kind, impact, offset_m,
+                                 T.DAM)
 
     n = int(round(duration_s / dt))
     if writer is not None:
@@ -246,8 +249,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
         if writer is not None and (i + 1) % write_every == 0:
             writer.write(problem.fields() + stresses(), problem.t)
         if rec.active > 0 and (i % stress_every == 0):
-            principal = fields.on_cells("max_principal_stress_Pa", probe.cells)
-            peak, _ = probe.peak_cellwise(principal)
+            peak, _ = probe.peak()
             history.append((problem.t, peak))
             p_peak = max(p_peak, problem.peak_contact_pressure_Pa())
     metrics = contact_metrics(problem.records, dt, filter_window_s=force_filter_window_s(s))

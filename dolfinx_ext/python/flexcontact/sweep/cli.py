@@ -62,7 +62,8 @@ def main(args) -> int:
     for o, w in summary["worst"].items():
         if w is not None:
             q = quantity(o, dim)
-            print(f"  worst {q.words.lower()}: {q.show(w['value'])} {q.unit} (scenario "
+            name = q.words[:1].lower() + q.words[1:]   # keeps a proper name's capital
+            print(f"  worst {name}: {q.show(w['value'])} {q.unit} (scenario "
                   f"{w['id']}: " + ", ".join(f"{k}={quantity(k, dim).show(v)}"
                                             for k, v in w["inputs"].items()) + ")")
     return 0

@@ -31,7 +31,8 @@ OUTPUTS = ("peak_force_N_per_m", "peak_force_filtered_N_per_m", "contact_duratio
            "impulse_N_s_per_m",
            "log_momentum_change_N_s_per_m", "heel_stress_static_Pa", "heel_stress_impact_Pa",
            "peak_tensile_stress_Pa", "peak_contact_pressure_Pa", "steps")
-"""The evaluator's outputs (plain floats; ``steps`` an integer)."""
+"""The evaluator's outputs (plain floats; ``steps`` an integer); in 3D also
+``halfspace_tension_Pa``."""
 
 
 class MonolithicEvaluator:
@@ -57,6 +58,7 @@ class MonolithicEvaluator:
 
     def evaluate(self, scenario) -> dict:
         """The outputs of one scenario (see :data:`OUTPUTS`). Collective over ``comm``."""
+        from ..dam.key_numbers import halfspace_surface_tension_Pa
         from ..dam.stage1 import solve_stage1
         from ..dam.stage2 import response_duration_s, solve_stage2
         stage1 = solve_stage1(scenario, comm=self.comm)
@@ -79,6 +81,10 @@ class MonolithicEvaluator:
                    st2.section_extremes().get("sigma_heel_max_Pa", -math.inf)),
                "peak_tensile_stress_Pa": st2.peak_tensile_stress_Pa,
                "peak_contact_pressure_Pa": st2.peak_contact_pressure_Pa}
+        halfspace = halfspace_surface_tension_Pa(scenario, m["peak_force_filtered"],
+                                                 IMPACT_OFFSET_M)
+        if halfspace is not None:
+            out["halfspace_tension_Pa"] = halfspace
         out = {k: float(v) for k, v in out.items()}
         out["steps"] = int(st2.timings_s["steps_n"])
         t = self._timings

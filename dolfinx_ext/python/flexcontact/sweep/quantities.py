@@ -104,6 +104,13 @@ def outputs(dim: int) -> dict:
             "Largest principal stress of the concrete (tension positive, not linearised) at "
             "the stated distance from the first contact point, peak over the contact.",
             "MPa", 1e-6, stress=True),
+        "halfspace_tension_Pa": Quantity(
+            "Half-space tension near the impact (Boussinesq)",
+            "Boussinesq's half-space surface tension (1 − 2ν) F/(2π r²) at the stated "
+            "distance r, F the filtered peak force: in 3D the face's tension there lies in "
+            "a layer thinner than the elements, so the principal stress read from the mesh "
+            "is low (docs/dam.md). Leaves out the tangential force and the static stress.",
+            "MPa", 1e-6, stress=True),
         "peak_contact_pressure_Pa": Quantity(
             "Peak contact pressure", "Largest nodal-average contact pressure on the log's "
             "end.", "MPa", 1e-6),

@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
-KEY_OUTPUTS = ("peak_force_N_per_m", "heel_stress_impact_Pa", "peak_tensile_stress_Pa")
+KEY_OUTPUTS = ("peak_force_N_per_m", "heel_stress_impact_Pa", "peak_tensile_stress_Pa",
+               "halfspace_tension_Pa")
 """The outputs whose most unfavourable case is reported (largest is worst), with the
 filtered peak force where the evaluator gives it (:func:`key_outputs`)."""
 DESIGN_OUTPUTS = ("peak_force_filtered_N_per_m", "peak_force_N_per_m", "impulse_N_s_per_m",
-                  "heel_stress_impact_Pa", "toe_stress_impact_Pa", "peak_tensile_stress_Pa")
+                  "heel_stress_impact_Pa", "toe_stress_impact_Pa", "peak_tensile_stress_Pa",
+                  "halfspace_tension_Pa")
 """The outputs a design reads: their rank correlations with the inputs are reported (the
 others — counts, steps, the time step, the log's own kinematics — stay in the table)."""
 ENVELOPE_OUTPUTS = DESIGN_OUTPUTS + ("contact_duration_s", "peak_contact_pressure_Pa")

@@ -138,7 +138,7 @@ def markdown(summary: dict, inputs: list) -> str:
                   None)
     for o in s["spearman"] or s["worst"]:
         d = q[o].definition
-        if o == "peak_tensile_stress_Pa" and offset is not None:
+        if o in ("peak_tensile_stress_Pa", "halfspace_tension_Pa") and offset is not None:
             d += f" Read at {three_figures(offset)} m from it."
         L.append(f"| {q[o].words} | {q[o].unit} | {d} |")
     L += ["", "## Most unfavourable scenarios", "",
