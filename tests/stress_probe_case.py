@@ -89,8 +89,6 @@ def flamant(cells_per_m: int, diagonal: str = "right"):
     2Q/(π r). Returns (the RecoveredStressProbe at r = OFFSET_M on the solution, that exact
     peak in Pa)."""
     import ufl
-    from petsc4py import PETSc
-    import dolfinx.fem.petsc
     from flexcontact.forms import sigma
     q = 1e6
     n = 2 * cells_per_m
@@ -122,24 +120,7 @@ def flamant(cells_per_m: int, diagonal: str = "right"):
         (V.sub(1), V1), lambda X: np.isclose(X[0], 2.0) & np.isclose(X[1], -2.0))
     bcs = [dolfinx.fem.dirichletbc(np.zeros(2), corner, V),
            dolfinx.fem.dirichletbc(dolfinx.fem.Function(V1), roller, V.sub(1))]
-    A = compat.assemble_matrix(a, bcs)
-    b = dolfinx.fem.petsc.assemble_vector(L)
-    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-    origin = np.flatnonzero(np.linalg.norm(V.tabulate_dof_coordinates()[:, :2], axis=1) < 1e-12)
-    with b.localForm() as loc:
-        loc.array[2 * origin] += q   # the line load, on whichever ranks hold the node
-    b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-    dolfinx.fem.petsc.set_bc(b, bcs)
-    ksp = PETSc.KSP().create(msh.comm)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    uh = dolfinx.fem.Function(V)
-    ksp.solve(b, compat.petsc_vec(uh))
-    uh.x.scatter_forward()
-    for obj in (ksp, A, b):
-        obj.destroy()
+    uh = _solve_with_point_force(V, a, L, bcs, 0, q)
     probe = RecoveredStressProbe(uh, tags, {1: CONCRETE}, "plane_strain", np.zeros(2),
                                  OFFSET_M, 1)
     return probe, 2.0 * q / (np.pi * OFFSET_M)
@@ -180,8 +161,6 @@ def boussinesq_box(cells_per_m: int, force_N: float = 1e6):
     node, the exact traction σ·n on the other faces, three corners pinned against the (zero)
     rigid motion. Returns (the displacement, the cell tags)."""
     import ufl
-    from petsc4py import PETSc
-    import dolfinx.fem.petsc
     from flexcontact.forms import sigma
     nu = CONCRETE.nu
     n = 2 * cells_per_m
@@ -219,14 +198,23 @@ def boussinesq_box(cells_per_m: int, force_N: float = 1e6):
                 (V.sub(k), Vk), lambda X, p=corner: np.isclose(X[0], p[0])
                 & np.isclose(X[1], p[1]) & np.isclose(X[2], p[2]))
             bcs.append(dolfinx.fem.dirichletbc(dolfinx.fem.Function(Vk), dofs, V.sub(k)))
+    uh = _solve_with_point_force(V, a, L, bcs, 2, -force_N)
+    return uh, tags
+
+
+def _solve_with_point_force(V, a, L, bcs, component: int, force_N: float):
+    """The displacement of a(u, v) = L(v) plus a point force (N, along ``component``) at the
+    origin's node, by MUMPS."""
+    from petsc4py import PETSc
+    import dolfinx.fem.petsc
     A = compat.assemble_matrix(a, bcs)
     b = dolfinx.fem.petsc.assemble_vector(L)
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     origin = np.flatnonzero(np.linalg.norm(V.tabulate_dof_coordinates(), axis=1) < 1e-12)
-    with b.localForm() as loc:
-        loc.array[3 * origin + 2] -= force_N
+    with b.localForm() as loc:   # on whichever ranks hold the node; only owners count
+        loc.array[V.dofmap.index_map_bs * origin + component] += force_N
     dolfinx.fem.petsc.set_bc(b, bcs)
-    ksp = PETSc.KSP().create(msh.comm)
+    ksp = PETSc.KSP().create(V.mesh.comm)
     ksp.setOperators(A)
     ksp.setType("preonly")
     ksp.getPC().setType("lu")
@@ -236,4 +224,4 @@ def boussinesq_box(cells_per_m: int, force_N: float = 1e6):
     uh.x.scatter_forward()
     for obj in (ksp, A, b):
         obj.destroy()
-    return uh, tags
+    return uh
