@@ -37,7 +37,7 @@ def cpp(obj):
     return getattr(obj, "_cpp_object", obj)
 
 
-def vector_space(msh, degree: int = 1, size: int = None):
+def vector_space(msh, degree: int = 1, size: "int | None" = None):
     """Continuous Lagrange vector space of ``size`` components (default: the mesh's
     geometric dimension)."""
     size = msh.geometry.dim if size is None else int(size)

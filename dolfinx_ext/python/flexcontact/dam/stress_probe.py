@@ -3,12 +3,12 @@
 
 With linear elements the stress is constant in each cell. Near a concentrated load it
 varies like 1/r² across a cell, and the cell constants scatter about the true field from
-cell to cell. Taking the largest of them over a sphere then picks the worst scatter:
-at the dam's default impact mesh (0.2 m cells, 0.5 m from the impact) the cell-wise peak
-is about twice the converged value. The volume-weighted average of the cell stresses at
-each node, interpolated linearly to the sample points, smooths that scatter out; it is the
-field ParaView users see after "Cell Data to Point Data", and docs/dam.md §6 gives the
-mesh study of both readings.
+cell to cell: the largest of them over a sphere is the worst scatter, and its error is
+first order. The volume-weighted average of the cell stresses at each node, interpolated
+linearly to the sample points, smooths the scatter out and converges about second order
+(Flamant's line load; docs/dam.md, "The peak principal stress near the impact", which also
+says what neither reading resolves: in 3D the face's tension near a normal force lies in a
+layer thinner than the dam's elements there).
 """
 from __future__ import annotations
 
@@ -62,8 +62,9 @@ class RecoveredStressProbe:
             ufl.inner(ones, tau) * ufl.Measure("dx", domain=msh, subdomain_data=cell_tags)(tag)),
             self._m)
         needed = np.unique(compat.cell_dofs(V)[self.offset.cells].reshape(-1))
-        patch = self._patch(msh, cell_tags, tag, np.asarray(point, float), float(offset_m),
-                            ones, tau, full, needed, V.dofmap.index_map_bs)
+        patch, self._mass = self._patch(msh, cell_tags, tag, np.asarray(point, float),
+                                        float(offset_m), ones, tau, full, needed,
+                                        V.dofmap.index_map_bs)
         dxp = ufl.Measure("dx", domain=msh, subdomain_data=patch)(PATCH)
         self._form = dolfinx.fem.form(
             ufl.inner(ufl.as_vector([s[i, j] for i, j in comps]), tau) * dxp)
@@ -81,9 +82,10 @@ class RecoveredStressProbe:
             return loc.array.copy()
 
     def _patch(self, msh, cell_tags, tag, point, offset_m, ones, tau, full, needed, bs):
-        """MeshTags of the shell of cells tagged ``tag`` whose midpoints lie within a margin
-        of the sphere: two sample-cell sizes at first, doubled until the lumped mass of
-        every needed node over the shell equals its mass over all of ``tag``."""
+        """(MeshTags of the shell of cells tagged ``tag`` whose midpoints lie within a
+        margin of the sphere, the lumped mass over it): the margin is two sample-cell sizes
+        at first, doubled until the lumped mass of every needed node over the shell equals
+        its mass over all of ``tag``."""
         tdim = msh.topology.dim
         n_cells = _owned_cells(msh) + msh.topology.index_map(tdim).num_ghosts
         x = compat.geometry_x(msh)
@@ -104,8 +106,7 @@ class RecoveredStressProbe:
                 self._m)
             short = bool(np.any(got[rows] < full[rows] * (1.0 - 1e-10)))
             if not self.comm.allreduce(short, op=MPI.LOR):
-                self._mass = got
-                return patch
+                return patch, got
             margin *= 2.0
         raise RuntimeError("RecoveredStressProbe: the averaging shell never covered the "
                            "sample cells' nodes")  # unreachable: the margin passes the mesh
