@@ -295,8 +295,9 @@ if not args.stage1_only:
               f"{args.impact_offset} m from the impact "
               f"{stage2.peak_tensile_stress_Pa / 1e6:.3f} MPa"
               + ("" if numbers["halfspace_tension_at_offset_Pa"] is None else
-                 f" (Boussinesq's half-space value for the normal force "
-                 f"{numbers['halfspace_tension_at_offset_Pa'] / 1e6:.3f} MPa)"))
+                 f" (half-space value with the tangential force and the static stress "
+                 f"{numbers['halfspace_tension_at_offset_Pa'] / 1e6:.3f} MPa, normal force "
+                 f"alone {numbers['halfspace_tension_normal_force_only_Pa'] / 1e6:.3f} MPa)"))
         print(f"linearised heel stress {numbers['sigma_heel_before_Pa'] / 1e6:.4f} MPa before, "
               f"up to {numbers['sigma_heel_during_max_Pa'] / 1e6:.4f} MPa during the impact")
 

@@ -75,9 +75,11 @@ def probe(dim, field, interface_x=None):
 
 if __name__ == "__main__":
     dim, field, out = int(sys.argv[1]), sys.argv[2], sys.argv[3]
-    value, where = probe(dim, field, interface_x=1.3).peak()
+    p = probe(dim, field, interface_x=1.3)
+    value, where = p.peak()
+    mean = p.mean()
     if MPI.COMM_WORLD.rank == 0:
-        np.savez(out, value=value, where=where)
+        np.savez(out, value=value, where=where, mean=mean)
 
 
 def flamant(cells_per_m: int, diagonal: str = "right"):
@@ -133,27 +135,11 @@ def boussinesq_principal(p, force_N: float, nu: float) -> np.ndarray:
 
 def boussinesq_stress(p, force_N: float, nu: float) -> np.ndarray:
     """Stress (k, 3, 3) in Pa of Boussinesq's solution at the points p (k, 3) of the
-    half-space z ≤ 0 under a normal force ``force_N`` pushing down at the origin (depth
-    ζ = −z, ρ and R the distances from the axis and the origin; Johnson, Contact
-    Mechanics, §3.2)."""
-    x, y, zeta = p[:, 0], p[:, 1], -p[:, 2]
-    rho, R = np.hypot(x, y), np.linalg.norm(p, axis=1)
-    c = force_N / (2.0 * np.pi)
-    s_rr = c * ((1 - 2 * nu) / rho ** 2 * (1 - zeta / R) - 3 * rho ** 2 * zeta / R ** 5)
-    s_tt = c * (1 - 2 * nu) * (zeta / R ** 3 - (1 - zeta / R) / rho ** 2)
-    s_zz = -3 * c * zeta ** 3 / R ** 5
-    s_rz = 3 * c * rho * zeta ** 2 / R ** 5
-    zero = np.zeros_like(x)
-    e_r = np.stack([x / rho, y / rho, zero], axis=1)
-    e_t = np.stack([-y / rho, x / rho, zero], axis=1)
-    e_z = np.stack([zero, zero, zero + 1.0], axis=1)
-
-    def outer(a, b):
-        return a[:, :, None] * b[:, None, :]
-    sig = (s_rr[:, None, None] * outer(e_r, e_r) + s_tt[:, None, None] * outer(e_t, e_t)
-           + s_zz[:, None, None] * outer(e_z, e_z)
-           + s_rz[:, None, None] * (outer(e_r, e_z) + outer(e_z, e_r)))
-    return sig
+    half-space z ≤ 0 under a normal force ``force_N`` pushing down at the origin: the
+    library's closed form (flexcontact.dam.halfspace, depth along +z) mirrored in z."""
+    from flexcontact.dam.halfspace import point_force_stress
+    mirror = np.diag([1.0, 1.0, -1.0])
+    return mirror @ point_force_stress(p @ mirror, (0.0, 0.0, force_N), nu) @ mirror
 
 
 def boussinesq_box(cells_per_m: int, force_N: float = 1e6):

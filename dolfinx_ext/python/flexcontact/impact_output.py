@@ -29,6 +29,19 @@ def filter_steps(window_s: Optional[float], dt_s: float) -> int:
     return k + 1 - k % 2
 
 
+def force_at_filtered_peak(normal_force, force_vectors, window_steps: int) -> np.ndarray:
+    """The force vector (d,) at the step where the filtered normal force peaks, filtered
+    the same way (the centred moving average of :func:`contact_metrics`): the direction of
+    the force the filtered peak force stands for. ``normal_force`` (n,), ``force_vectors``
+    (n, d), one row per step."""
+    F = np.asarray(normal_force, float)
+    V = np.asarray(force_vectors, float).reshape(F.size, -1)
+    if not F.size:
+        return np.zeros(V.shape[1])
+    i = int(np.argmax(moving_average(F, window_steps)))
+    return np.array([moving_average(V[:, k], window_steps)[i] for k in range(V.shape[1])])
+
+
 def contact_metrics(records: Sequence, dt_s: float, threshold: float = 1e-6,
                     filter_window_s: Optional[float] = None) -> dict:
     """Peak force, filtered peak force, contact start, end and duration, impulse, mean force

@@ -27,11 +27,11 @@ import numpy as np
 from .. import _cpp
 from ..condensation import kernel_pairs
 from ..pairing import pair_caps
-from ..impact_output import contact_metrics
+from ..impact_output import contact_metrics, filter_steps, force_at_filtered_peak
 from ..postprocess import impact_step_forces, peak_pressure_Pa
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
-from .key_numbers import halfspace_surface_tension_Pa
+from .key_numbers import halfspace_tension_Pa
 from .log_model import rotation
 from .stage2 import (MARGIN, approach_time_s, force_filter_window_s, log_crushing_strength_Pa,
                      response_duration_s)
@@ -138,6 +138,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     impact = np.array(s.log_front_point, float)
     impact[0] = 0.0  # on the face
     probe = dam.stress_probe(impact, offset_m)
+    static_stress = dam.static_stress_Pa(static, probe) if d == 3 else None
     n = run_steps(s, dam)
     records, peak_principal, p_peak = [], -math.inf, 0.0
     section = {q: np.zeros(n) for q in dam.section_gradients}
@@ -208,6 +209,12 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     heel = static.section.sigma_heel_Pa + float(section["sigma_heel_Pa"].max())
     out = _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_peak,
                    offset_m, n)
+    if d == 3:
+        # The face impulses are the dam's (x along its inward normal, as the normal force).
+        forces = impulses.reshape(n, -1, d).sum(axis=1) / h
+        force = force_at_filtered_peak([r.normal_force for r in records], forces,
+                                       filter_steps(force_filter_window_s(s), h))
+        out["halfspace_tension_Pa"] = halfspace_tension_Pa(s, force, static_stress, offset_m)
     out.update(_section_outputs(static, section))
     out["dam_back_substitutions"] = dam.back_substitutions["dam_stage2"] - solves0[0]
     out["log_back_substitutions"] = log.back_substitutions - solves0[1]
@@ -216,13 +223,6 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
         out["history"] = section
         out["face_impulses"] = impulses[:last_contact + 1]
     return out
-
-
-def _halfspace(s, force_N: float, offset_m: float) -> dict:
-    """In 3D, Boussinesq's surface tension at the offset under the filtered peak force
-    (key_numbers.halfspace_surface_tension_Pa), beside the stress read from the mesh."""
-    value = halfspace_surface_tension_Pa(s, force_N, offset_m)
-    return {} if value is None else {"halfspace_tension_Pa": value}
 
 
 def _section_outputs(static, section: dict) -> dict:
@@ -299,7 +299,6 @@ def _outputs(s, dam, log, static, records, h, bl, R, heel, peak_principal, p_pea
         "heel_stress_static_Pa": static_heel,
         "heel_stress_impact_Pa": heel,
         "peak_tensile_stress_Pa": peak_principal if math.isfinite(peak_principal) else math.nan,
-        **_halfspace(s, m["peak_force_filtered"], offset_m),
         "stress_offset_m": float(offset_m),
         "peak_contact_pressure_Pa": p_peak,
         "steps": int(n),

@@ -429,6 +429,12 @@ class DamModel:
         self._u_total.x.scatter_forward()
         return probe.peak()[0]
 
+    def static_stress_Pa(self, static: StaticState, probe: RecoveredStressProbe) -> np.ndarray:
+        """The recovered static stress (3, 3) in Pa averaged over ``probe``'s samples (see
+        :meth:`RecoveredStressProbe.mean`)."""
+        self._u_total.x.array[:] = static.u.x.array
+        return probe.mean()
+
     def counts(self) -> dict:
         out = {"factorizations": dict(self.factorizations),
                "back_substitutions": dict(self.back_substitutions)}

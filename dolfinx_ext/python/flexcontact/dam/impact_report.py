@@ -68,7 +68,7 @@ def _limits(st2: dict | None, westergaard: bool = False, dim: int = 2) -> list:
             f"| peak σ₁ at {st2['impact_offset_m']:g} m from the impact / concrete tensile "
             f"strength | {_mpa(st2['peak_max_principal_stress_near_impact_Pa'])} MPa | "
             f"cracking | {st2['peak_stress_over_tensile_strength']:.3g} |",
-            *_halfspace_row(st2, "| Boussinesq surface tension at {r:g} m (normal force) "
+            *_halfspace_row(st2, "| half-space σ₁ at {r:g} m (Boussinesq + Cerruti + static) "
                             "/ concrete tensile strength | {v} MPa | cracking | {q:.3g} |"),
             f"| linearised heel stress during impact / tensile strength | "
             f"{_mpa(st2['sigma_heel_during_max_Pa'])} MPa | cracking | "
@@ -150,9 +150,12 @@ def _stage2(st2: dict, u: dict) -> list:
         + "".join(_halfspace_row(st2, (
             " In 3D that tension lies in a layer of the face about 0.1 r deep, which the "
             "impact zone's elements do not resolve: this reading is low (docs/dam.md). "
-            "Boussinesq's half-space value for the filtered peak force alone, "
-            "(1 − 2ν) F / (2π r²), is {v} MPa at r = {r:g} m; it leaves out the tangential "
-            "force and the static stress."))),
+            "The half-space value, the largest principal stress on the hemisphere of "
+            "r = {r:g} m from the closed forms for the force at the filtered peak "
+            "(Boussinesq for its normal part, Cerruti for its tangential part) plus the "
+            "static stress there, is {v} MPa; the normal force alone would give "
+            "(1 − 2ν) F / (2π r²) = {n} MPa. It assumes the face flat and the crest and "
+            "the block's sides far compared with r."))),
         ""]
 
 
@@ -161,7 +164,8 @@ def _halfspace_row(st2: dict, text: str) -> list:
     v = st2.get("halfspace_tension_at_offset_Pa")
     if v is None:
         return []
-    return [text.format(r=st2["impact_offset_m"], v=_mpa(v),
+    n = st2.get("halfspace_tension_normal_force_only_Pa")
+    return [text.format(r=st2["impact_offset_m"], v=_mpa(v), n="?" if n is None else _mpa(n),
                         q=st2["halfspace_tension_over_tensile_strength"])]
 
 

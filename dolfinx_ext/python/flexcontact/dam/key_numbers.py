@@ -20,7 +20,9 @@ def engineer_numbers(s, stage1, stage2) -> dict:
     ft, fc = s.concrete_tensile_strength_Pa, s.wood_crushing_strength_Pa
     met = stage2.metrics
     sigma_peak = stage2.peak_tensile_stress_Pa
-    halfspace = halfspace_surface_tension_Pa(s, met["peak_force_filtered"], stage2.offset_m)
+    halfspace = halfspace_tension_Pa(s, stage2.force_at_filtered_peak_N,
+                                     stage2.static_stress_near_impact_Pa, stage2.offset_m)
+    normal_only = halfspace_surface_tension_Pa(s, met["peak_force_filtered"], stage2.offset_m)
     return {
         "sigma_heel_before_Pa": before.sigma_heel_Pa,
         "sigma_heel_before_Pa_ref": stage1.reference.sigma_heel_Pa,
@@ -50,6 +52,9 @@ def engineer_numbers(s, stage1, stage2) -> dict:
         "peak_stress_over_tensile_strength": sigma_peak / ft,
         "halfspace_tension_at_offset_Pa": halfspace,
         "halfspace_tension_over_tensile_strength": None if halfspace is None else halfspace / ft,
+        "halfspace_tension_normal_force_only_Pa": normal_only,
+        "force_at_filtered_peak_N": (None if stage2.force_at_filtered_peak_N is None
+                                     else [float(f) for f in stage2.force_at_filtered_peak_N]),
         "peak_contact_pressure_Pa": stage2.peak_contact_pressure_Pa,
         "peak_pressure_over_wood_crushing_strength": stage2.peak_contact_pressure_Pa / fc,
         "log_max_rotation_rad": stage2.log_max_rotation_rad,
@@ -65,6 +70,21 @@ def engineer_numbers(s, stage1, stage2) -> dict:
         "crushing_pairs_max": max((r.crush for r in stage2.problem.records), default=0),
         "contact_element_size_m": s.h_contact_m,
     }
+
+
+def halfspace_tension_Pa(s, force_on_dam_N, static_stress_Pa, r_m: float):
+    """The largest principal stress on the hemisphere of radius ``r_m`` around the impact
+    point in 3D, from the closed-form half-space fields of the force ``force_on_dam_N`` (3,),
+    global axes (Boussinesq for its normal part, Cerruti for its tangential part: friction,
+    pitch, yaw), plus the dam's static stress ``static_stress_Pa`` (3, 3) there taken as
+    uniform (see :mod:`~flexcontact.dam.halfspace`). The face x = 0 is the half-space's
+    surface, the dam on x > 0. None in 2D (see :func:`halfspace_surface_tension_Pa`) or
+    without a force."""
+    if s.dim != 3 or force_on_dam_N is None:
+        return None
+    from .halfspace import peak_tension_Pa
+    return peak_tension_Pa(force_on_dam_N, (1.0, 0.0, 0.0), s.concrete.nu, r_m,
+                           static_stress_Pa)[0]
 
 
 def halfspace_surface_tension_Pa(s, force_N: float, r_m: float):

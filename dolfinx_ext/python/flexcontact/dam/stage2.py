@@ -44,7 +44,7 @@ import dolfinx.fem
 from ..boundary import dirichlet
 from ..dynamics import ImpactProblem
 from ..forms import Material
-from ..impact_output import contact_metrics
+from ..impact_output import contact_metrics, filter_steps, force_at_filtered_peak
 from ..meshes import dam_tags as T
 from ..problem import ContactInterface
 from .fields import StressFields
@@ -80,6 +80,8 @@ class Stage2Result:
     peak_time_s: float = float("nan")
     log_max_rotation_rad: float = 0.0
     log_max_strain: float = 0.0
+    force_at_filtered_peak_N: Any = None   # (d,) on the dam, global axes (N/m in 2D)
+    static_stress_near_impact_Pa: Any = None   # (3, 3) recovered, mean over the offset's samples
 
     def section_extremes(self) -> dict:
         """Extremes over the run of the linearised base stresses (Pa, tension positive)
@@ -240,6 +242,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
     probe = RecoveredStressProbe(problem.u, cells, materials, stage1.kind, impact, offset_m,
                                  T.DAM)
 
+    static_stress = probe.mean()   # the run starts from the static state
     n = int(round(duration_s / dt))
     if writer is not None:
         writer.write(problem.fields() + stresses(), 0.0)
@@ -253,12 +256,16 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
             history.append((problem.t, peak))
             p_peak = max(p_peak, problem.peak_contact_pressure_Pa())
     metrics = contact_metrics(problem.records, dt, filter_window_s=force_filter_window_s(s))
+    force_peak = -force_at_filtered_peak(   # the log is the slave: the dam takes the opposite
+        [r.normal_force for r in problem.records], [r.slave_force for r in problem.records],
+        filter_steps(force_filter_window_s(s), dt))
     m_eff, v0, v1 = _log_momentum(problem)
     return Stage2Result(problem, metrics, m_eff * (v1 - v0), m_eff, v0, v1, history, impact,
                         offset_m, p_peak, {"setup": t_setup, "steps": time.perf_counter() - t0 - t_setup,
                                    "dt_s": dt, "duration_s": duration_s, "steps_n": n},
                         watch.sections, watch.peak_u, watch.peak_t,
-                        watch.log.max_rotation_rad, watch.log.max_strain)
+                        watch.log.max_rotation_rad, watch.log.max_strain, force_peak,
+                        static_stress)
 
 
 class _Watch:

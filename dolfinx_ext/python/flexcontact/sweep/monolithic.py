@@ -58,7 +58,7 @@ class MonolithicEvaluator:
 
     def evaluate(self, scenario) -> dict:
         """The outputs of one scenario (see :data:`OUTPUTS`). Collective over ``comm``."""
-        from ..dam.key_numbers import halfspace_surface_tension_Pa
+        from ..dam.key_numbers import halfspace_tension_Pa
         from ..dam.stage1 import solve_stage1
         from ..dam.stage2 import response_duration_s, solve_stage2
         stage1 = solve_stage1(scenario, comm=self.comm)
@@ -81,8 +81,8 @@ class MonolithicEvaluator:
                    st2.section_extremes().get("sigma_heel_max_Pa", -math.inf)),
                "peak_tensile_stress_Pa": st2.peak_tensile_stress_Pa,
                "peak_contact_pressure_Pa": st2.peak_contact_pressure_Pa}
-        halfspace = halfspace_surface_tension_Pa(scenario, m["peak_force_filtered"],
-                                                 IMPACT_OFFSET_M)
+        halfspace = halfspace_tension_Pa(scenario, st2.force_at_filtered_peak_N,
+                                         st2.static_stress_near_impact_Pa, IMPACT_OFFSET_M)
         if halfspace is not None:
             out["halfspace_tension_Pa"] = halfspace
         out = {k: float(v) for k, v in out.items()}

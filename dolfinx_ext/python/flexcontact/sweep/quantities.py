@@ -105,11 +105,13 @@ def outputs(dim: int) -> dict:
             "the stated distance from the first contact point, peak over the contact.",
             "MPa", 1e-6, stress=True),
         "halfspace_tension_Pa": Quantity(
-            "Half-space tension near the impact (Boussinesq)",
-            "Boussinesq's half-space surface tension (1 − 2ν) F/(2π r²) at the stated "
-            "distance r, F the filtered peak force: in 3D the face's tension there lies in "
-            "a layer thinner than the elements, so the principal stress read from the mesh "
-            "is low (docs/dam.md). Leaves out the tangential force and the static stress.",
+            "Half-space tension near the impact (Boussinesq + Cerruti)",
+            "Largest principal stress on the hemisphere of the stated radius r around the "
+            "first contact point, from the closed-form half-space fields of the force at "
+            "the filtered peak (Boussinesq for its normal part, Cerruti for its tangential "
+            "part) plus the static stress there: in 3D the face's tension lies in a layer "
+            "thinner than the elements, so the principal stress read from the mesh is low "
+            "(docs/dam.md). Assumes the face flat and the crest and block sides far.",
             "MPa", 1e-6, stress=True),
         "peak_contact_pressure_Pa": Quantity(
             "Peak contact pressure", "Largest nodal-average contact pressure on the log's "
