@@ -83,9 +83,10 @@ class RecoveredStressProbe:
 
     def _patch(self, msh, cell_tags, tag, point, offset_m, ones, tau, full, needed, bs):
         """(MeshTags of the shell of cells tagged ``tag`` whose midpoints lie within a
-        margin of the sphere, the lumped mass over it): the margin is two sample-cell sizes
-        at first, doubled until the lumped mass of every needed node over the shell equals
-        its mass over all of ``tag``."""
+        margin of the sphere, the lumped mass over it): the margin is one sample-cell size
+        at first (every call assembles the shell, so a thin one pays), grown by half until
+        the lumped mass of every needed node over the shell equals its mass over all of
+        ``tag``."""
         tdim = msh.topology.dim
         n_cells = _owned_cells(msh) + msh.topology.index_map(tdim).num_ghosts
         x = compat.geometry_x(msh)
@@ -96,9 +97,9 @@ class RecoveredStressProbe:
         tagged[cell_tags.indices[cell_tags.values == tag]] = True
         dist = np.abs(np.linalg.norm(mid[:, :point.size] - point, axis=1) - offset_m)
         own = size[self.offset.cells].max() if len(self.offset.cells) else 0.0
-        margin = 2.0 * self.comm.allreduce(float(own), op=MPI.MAX)
+        margin = self.comm.allreduce(float(own), op=MPI.MAX)
         rows = (needed[:, None] * bs + np.arange(bs)).reshape(-1)
-        for _ in range(32):
+        for _ in range(64):
             cells = np.flatnonzero(tagged & (dist <= margin)).astype(np.int32)
             patch = dolfinx.mesh.meshtags(msh, tdim, cells, np.full(cells.size, PATCH, np.int32))
             got = self._assemble(dolfinx.fem.form(
@@ -107,7 +108,7 @@ class RecoveredStressProbe:
             short = bool(np.any(got[rows] < full[rows] * (1.0 - 1e-10)))
             if not self.comm.allreduce(short, op=MPI.LOR):
                 return patch, got
-            margin *= 2.0
+            margin *= 1.5
         raise RuntimeError("RecoveredStressProbe: the averaging shell never covered the "
                            "sample cells' nodes")  # unreachable: the margin passes the mesh
 
