@@ -432,7 +432,9 @@ class DamModel:
     def static_stress_Pa(self, static: StaticState, probe: RecoveredStressProbe) -> np.ndarray:
         """The recovered static stress (3, 3) in Pa averaged over ``probe``'s samples (see
         :meth:`RecoveredStressProbe.mean`)."""
-        self._u_total.x.array[:] = static.u.x.array
+        n = compat.petsc_vec(static.u).getLocalSize()
+        self._u_total.x.array[:n] = static.u.x.array[:n]
+        self._u_total.x.scatter_forward()
         return probe.mean()
 
     def counts(self) -> dict:
