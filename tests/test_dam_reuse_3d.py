@@ -126,9 +126,6 @@ def test_each_ones_own_mesh(own_meshes):
     assert got["peak_force_filtered_N_per_m"] == pytest.approx(
         ref["peak_force_filtered_N_per_m"], rel=0.02)
     assert got["stress_offset_m"] == IMPACT_OFFSET_M
-    # The half-space tension at 1 m is closed-form in the force and the smooth static
-    # stress: it follows the filtered peak force (2 %), plus 1 % for the static stress.
-    assert got["halfspace_tension_Pa"] == pytest.approx(ref["halfspace_tension_Pa"], rel=0.03)
 
 
 @pytest.mark.xfail(strict=True, reason=(
