@@ -57,6 +57,24 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   zero_constrained(F_, constrained_, who);
   start();
   W_ = delassus(B_, F_);
+  keep_read_rows();
+}
+
+void ImpactContact::keep_read_rows()
+{
+  read_.clear();
+  for (Eigen::Index j = 0; j < B_.outerSize(); ++j)
+    if (Eigen::SparseMatrix<double>::InnerIterator(B_, j))
+      read_.push_back(j);
+  if (2 * static_cast<Eigen::Index>(read_.size()) > F_.rows())
+  {
+    read_.clear();
+    F_read_.resize(0, 0);
+    return;
+  }
+  F_read_.resize(static_cast<Eigen::Index>(read_.size()), F_.cols());
+  for (std::size_t a = 0; a < read_.size(); ++a)
+    F_read_.row(static_cast<Eigen::Index>(a)) = F_.row(read_[a]);
 }
 
 void ImpactContact::check_scheme() const
@@ -129,6 +147,7 @@ void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
   W_ = delassus(B_, Fhat);
   F_ = std::move(Fhat);
   dt_ = dt_s;
+  keep_read_rows();
 }
 
 void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
@@ -152,6 +171,8 @@ void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector 
   cap_ = std::move(cap);
   columns_ = PairColumns{}; // they depend on B
   columns_.slot.assign(pairs_.size(), -1);
+  if (!factor_path())
+    keep_read_rows();
 }
 
 ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
@@ -217,14 +238,38 @@ ImpactStep ImpactContact::step_condensed(const Eigen::Ref<const Vector>& u_c,
   check_vector("b_c", b_c, contact_dofs());
   check_vector("v_c", v_c, contact_dofs());
   // F_ has the held rows and columns zeroed; Ŵ's identity rows give them (Ŵ⁻¹)_ii = 1.
-  Vector dv_free = F_ * b_c;
-  for (std::size_t i = 0; i < constrained_.size(); ++i)
-    if (constrained_[i])
-      dv_free[static_cast<Eigen::Index>(i)] = b_c[static_cast<Eigen::Index>(i)];
-  const Vector vfree_c = v_c + dv_free;
+  // Before the solve only the DOFs that B reads need v_free; the whole velocity change
+  // F̂ (b̃_c + r_c) is then one product with F̂ instead of two. A body at rest (b̃_c = 0)
+  // and a step without impulse cost no product at all.
+  const auto held = [&](Eigen::Index i)
+  { return static_cast<std::size_t>(i) < constrained_.size() && constrained_[i]; };
+  const bool loaded = !(b_c.array() == 0.0).all();
+  Vector vfree_c = v_c;
+  if (loaded && !read_.empty())
+  {
+    const Vector dv = F_read_ * b_c;
+    for (std::size_t a = 0; a < read_.size(); ++a)
+    {
+      const Eigen::Index i = read_[a];
+      vfree_c[i] += held(i) ? b_c[i] : dv[static_cast<Eigen::Index>(a)];
+    }
+  }
+  else if (loaded)
+  {
+    Vector dv = F_ * b_c;
+    for (Eigen::Index i = 0; i < dv.size(); ++i)
+      if (held(i))
+        dv[i] = b_c[i];
+    vfree_c += dv;
+  }
   ImpactStep r = step(u_c, v_c, vfree_c);
-  // r_c is zero on held DOFs, where F_'s zeroed columns leave dv_free's value.
-  r.velocity_change_c = dv_free + F_ * r.reaction;
+  const Vector load = b_c + r.reaction;
+  r.velocity_change_c = (load.array() == 0.0).all() ? Vector::Zero(load.size())
+                                                    : Vector(F_ * load);
+  // r_c is zero on held DOFs, where F_'s zeroed rows leave b̃_c's value to set.
+  for (Eigen::Index i = 0; i < load.size(); ++i)
+    if (held(i))
+      r.velocity_change_c[i] = b_c[i];
   r.velocity_c = v_c + r.velocity_change_c;
   return r;
 }

@@ -235,6 +235,67 @@ TEST(Impact, CondensedStepHoldsHeldDofsAndNamesBadInput)
             std::string::npos);
 }
 
+TEST(Impact, CondensedStepOnAFewOfManyContactNodesEqualsTheWholeProduct)
+{
+  // Five contact nodes, one pair (slave 0 on master 3): B reads 4 of the 10 DOFs, so the
+  // free velocity before the solve is formed on those rows only, and the velocity change
+  // after it from one product F (b + r). It must equal the two whole products of
+  // v_free = v + F b, Δv = F b + F r, on every DOF, held ones (node 4) included.
+  const int n = 10;
+  Matrix A = Matrix::Zero(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      A(i, j) = 1.0 / (1.0 + i + j) + (i == j ? 1.0 : 0.0); // SPD (Hilbert + I)
+  std::vector<bool> held(n, false);
+  held[8] = held[9] = true;
+  Matrix F = A;
+  for (int i = 8; i < n; ++i)
+  {
+    F.row(i).setZero();
+    F.col(i).setZero();
+  }
+  const Matrix X = Matrix::Zero(5, 2);
+  const auto pair_on = [](int master)
+  { return std::vector<ContactPair>{make_pair(0, {master}, {1.0}, vec({1.0, 0.0}))}; };
+  ImpactContact c(2, A, X, pair_on(3), vec({0.3}), 0.0, 1e-3, 0.5, held);
+  ImpactContact whole(2, A, X, pair_on(3), vec({0.3}), 0.0, 1e-3, 0.5, held);
+  const Vector u = Vector::Zero(n);
+  Vector v(n), b(n);
+  for (int i = 0; i < n; ++i)
+  {
+    v[i] = 0.1 * std::sin(1.0 + i);
+    b[i] = -0.5 + 0.2 * std::cos(2.0 * i);
+  }
+  v[0] = -0.5; // the slave approaches either master
+  auto check = [&](ImpactContact& a, ImpactContact& ref)
+  {
+    const ImpactStep s = a.step_condensed(u, v, b);
+    Vector dv = F * b;
+    for (int i = 8; i < n; ++i)
+      dv[i] = b[i];
+    const ImpactStep t = ref.step(u, v, v + dv);
+    ASSERT_EQ(s.active_pairs, 1);
+    EXPECT_LE((s.impulse - t.impulse).norm(), 1e-13 * t.impulse.norm());
+    Vector expected = dv + F * t.reaction;
+    EXPECT_LE((s.velocity_change_c - expected).norm(), 1e-13 * expected.norm());
+    EXPECT_EQ(s.velocity_change_c[8], b[8]);
+    EXPECT_EQ(s.velocity_change_c[9], b[9]);
+  };
+  check(c, whole);
+  // Re-paired on master 1: the rows read change with B.
+  c.set_pairs(pair_on(1), vec({0.3}));
+  whole.set_pairs(pair_on(1), vec({0.3}));
+  check(c, whole);
+  // A body at rest away from contact: no load, no impulse, no velocity change at all.
+  ImpactContact apart(2, A, Matrix::Constant(5, 2, 0.0), pair_on(3), vec({0.3}), 0.0, 1e-3,
+                      0.5, held);
+  Vector away = Vector::Zero(n);
+  away[0] = 1.0; // the gap n·(u_slave − u_master) opens by 1 m
+  const ImpactStep r = apart.step_condensed(away, Vector::Zero(n), Vector::Zero(n));
+  EXPECT_EQ(r.active_pairs, 0);
+  EXPECT_EQ(r.velocity_change_c.norm(), 0.0);
+}
+
 namespace
 {
 /// @brief One contact step of a slave node against a held wall node, W = I on the pair:

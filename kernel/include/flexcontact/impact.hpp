@@ -189,6 +189,8 @@ private:
   double crush_of(int k) const;
   /// @brief Factor path: W_eff's columns of `pairs` held (fetched if missing).
   void fetch(const std::vector<int>& pairs);
+  /// @brief Dense path: the contact DOFs B reads and F̂'s rows there (step_condensed).
+  void keep_read_rows();
 
   int dim_;
   Matrix F_;
@@ -201,6 +203,10 @@ private:
   Eigen::SparseMatrix<double> B_;
   Vector x0_;
   Matrix W_;
+  /// Dense path: the contact DOFs with a column in B (sorted), and F̂'s rows there, kept
+  /// when they are at most half of F̂ (otherwise empty and F̂ b̃_c is formed whole).
+  std::vector<Eigen::Index> read_;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> F_read_;
   Vector cap_;                     ///< force caps per pair, empty: no crushing
   Vector crush_node_;              ///< crush depth δ per contact node [m]
   Vector last_P_;                  ///< warm start
