@@ -122,7 +122,8 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     slave = log.placed_front(R, s.log_centre)
     pairs = build_surface_pairs([("node_to_surface", slave, dam.face)], d)
     m = pairs.m
-    F = np.zeros((d * pairs.x.shape[0],) * 2)
+    # Column-major, as the kernel holds it: handed over by a plain copy, not a transpose.
+    F = np.zeros((d * pairs.x.shape[0],) * 2, order="F")
     n_log = d * m
     F[:n_log, :n_log] = log.W_front_global(R)
     F[n_log:, n_log:] = dam.W_face
