@@ -8,7 +8,8 @@ Two references:
   mesh (meshes/merge.py), on which the monolithic stages run. The two methods then solve
   the same discrete problem: every output agrees to 1e-8 (measured at most 4e-12);
 * **each one's own mesh** at the 3D default sizes (far 6 m, impact 0.4 m): the two meshes
-  differ, and so do their answers, by the discretisation error.
+  differ, and so do their answers, by the discretisation error; and again at far 3 m,
+  impact 0.3 m, the block of the 1,000-scenario bench.
 
 Serial (COMM_SELF: the evaluator is one process's).
 """
@@ -149,6 +150,45 @@ def test_heel_stress_change_on_each_ones_own_mesh(own_meshes):
     d_got = got["heel_stress_impact_Pa"] - got["heel_stress_static_Pa"]
     d_ref = ref["heel_stress_impact_Pa"] - ref["heel_stress_static_Pa"]
     assert d_got == pytest.approx(d_ref, rel=0.05)
+
+
+FINE = DamScenario(dim=3, mesh_size_far_m=3.0, mesh_size_impact_m=0.3)
+"""The dam block of bench/sweep_1000_3d_3m.toml, where 1,000 scenarios take under 30 min."""
+
+
+@pytest.fixture(scope="module")
+def own_meshes_fine():
+    """The base scenario on each method's own mesh at far 3 m, impact 0.3 m."""
+    dt = sweep_time_step_s([FINE])
+    fine = ScenarioEvaluator(FINE, dt, (FINE.water_level_m - 1.0, FINE.water_level_m), COMM)
+    return fine.evaluate(FINE), MonolithicEvaluator(FINE, dt).evaluate(FINE)
+
+
+def test_each_ones_own_mesh_at_3m_03m(own_meshes_fine):
+    """At the resolution the 1,000-scenario bench runs (docs/dam.md, "Sweeps"): impulse
+    within 1 %, filtered peak force within 2 %, Δσ_heel and the half-space tension within
+    5 %. Measured: +0.15 %, −0.30 %, −0.72 %, −0.78 %."""
+    got, ref = own_meshes_fine
+    assert got["impulse_N_s_per_m"] == pytest.approx(ref["impulse_N_s_per_m"], rel=0.01)
+    assert got["peak_force_filtered_N_per_m"] == pytest.approx(
+        ref["peak_force_filtered_N_per_m"], rel=0.02)
+    d_got = got["heel_stress_impact_Pa"] - got["heel_stress_static_Pa"]
+    d_ref = ref["heel_stress_impact_Pa"] - ref["heel_stress_static_Pa"]
+    assert d_ref > 0
+    assert d_got == pytest.approx(d_ref, rel=0.05)
+    assert got["halfspace_tension_Pa"] == pytest.approx(ref["halfspace_tension_Pa"], rel=0.05)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the recovered peak principal stress 1 m from the contact differs by −10.7 % between the "
+    "two meshes at far 3 m / impact 0.3 m (+5.9 % at 6 m / 0.4 m): r/h = 3.3, and neither "
+    "mesh resolves the face's tension layer (docs/dam.md, 'The peak principal stress near "
+    "the impact')"))
+def test_peak_principal_stress_on_each_ones_own_mesh_at_3m_03m(own_meshes_fine):
+    """Within 5 %."""
+    got, ref = own_meshes_fine
+    assert got["peak_tensile_stress_Pa"] == pytest.approx(ref["peak_tensile_stress_Pa"],
+                                                          rel=0.05)
 
 
 def test_a_log_beyond_the_face_patch_is_named(evaluator):
