@@ -1,7 +1,8 @@
-"""A factor kept on disk (flexcontact.saved_factor, dolfinx_ext/src/saved_factor.cpp):
-saved by MUMPS in one process, restored in another, the same solves; files that are
-missing, truncated, altered or from another MUMPS are refused by name before MUMPS reads
-them. Reference: scipy's sparse LU of the same matrix."""
+"""A factor kept on disk (flexcontact.saved_factor, dolfinx_ext/src/saved_factor.cpp and
+distributed_schur.cpp): saved by MUMPS in one process, restored in another, the same solves
+(and, for a factor with a Schur complement, the same condensations and expansions); files
+that are missing, truncated, altered or from another MUMPS are refused by name before MUMPS
+reads them. Reference: scipy's sparse LU of the same matrix."""
 import json
 import subprocess
 import sys
@@ -17,11 +18,12 @@ from flexcontact import saved_factor
 from flexcontact.errors import FlexcontactError, SavedFileError
 
 
-def matrix(n=40):
-    """A symmetric indefinite matrix: a shifted 2D Laplacian on an n × n grid with its first
-    row and column replaced by a held DOF (a 1 on the diagonal), as a PETSc AIJ."""
+def matrix(n=40, shift=-0.3):
+    """A symmetric matrix (indefinite for the default shift): a shifted 2D Laplacian on an
+    n × n grid with its first row and column replaced by a held DOF (a 1 on the diagonal),
+    as a PETSc AIJ."""
     T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
-    A = (sp.kron(T, sp.eye(n)) + sp.kron(sp.eye(n), T) - 0.3 * sp.eye(n * n)).tolil()
+    A = (sp.kron(T, sp.eye(n)) + sp.kron(sp.eye(n), T) + shift * sp.eye(n * n)).tolil()
     A[0, :] = 0
     A[:, 0] = 0
     A[0, 0] = 1.0
@@ -128,3 +130,99 @@ def test_a_size_that_does_not_match_is_named(saved):
     f = saved_factor.restore_factor(folder, entry)
     with pytest.raises(ValueError, match="entries"):
         f.solve(vec(np.zeros(3)), vec(np.zeros(3)))
+
+
+# ---- a factor with a Schur complement (the dam's Ŵ in a model file) ------------------------
+
+SCHUR_DOFS = np.arange(40 * 20, 40 * 20 + 40)  # a grid line across the middle, in its order
+
+
+@pytest.fixture(scope="module")
+def saved_schur(tmp_path_factory):
+    A, M = matrix(shift=0.05)  # definite: F* is the Schur complement's Cholesky inverse
+    folder = tmp_path_factory.mktemp("schur")
+    F, f, _ = saved_factor._cpp.flexibility(M, SCHUR_DOFS, "schur", "auto", False, False)
+    F = np.asarray(F)
+    entry = saved_factor.save_factor(f, folder, "dam_stage2")
+    b = np.random.default_rng(5).standard_normal(A.shape[0])
+    u_c = np.random.default_rng(6).standard_normal(SCHUR_DOFS.size)
+    (folder / "manifest.json").write_text(json.dumps(entry))
+    np.save(folder / "b.npy", b)
+    np.save(folder / "u_c.npy", u_c)
+    np.save(folder / "F.npy", F)
+    return A, f, F, folder, entry, b, u_c
+
+
+def split_solves(f, b, u_c):
+    """The condensation of b, the expansion of u_c after it, and a full solve of b."""
+    bc = f.condense(vec(b)).copy()
+    x = vec(np.zeros(b.size))
+    f.expand(u_c, x)
+    return bc, x.array.copy(), solve(f, b)
+
+
+def test_a_schur_factor_restored_in_another_process_condenses_and_expands_alike(saved_schur):
+    """Saved with its Schur complement ("kind": "schur"), restored in a new process from
+    MUMPS's files: condense, expand and solve equal the saving process's bitwise, and agree
+    with scipy: b̃_c = b_c − A_ci A_ii⁻¹ b_i, x_i = A_ii⁻¹(b_i − A_ic u_c), x = A⁻¹ b
+    (1e-11)."""
+    A, f, F, folder, entry, b, u_c = saved_schur
+    assert entry["kind"] == "schur" and entry["schur_rows"] == SCHUR_DOFS.size
+    code = f"""
+import json, numpy as np
+from pathlib import Path
+from petsc4py import PETSc
+from flexcontact import saved_factor
+folder = Path({str(folder)!r})
+entry = json.loads((folder / "manifest.json").read_text())
+b, u_c = np.load(folder / "b.npy"), np.load(folder / "u_c.npy")
+g = saved_factor.restore_factor(folder, entry, {SCHUR_DOFS.tolist()!r}, np.load(folder / "F.npy"))
+assert g.has_condense and g.n_schur == u_c.size and g.size == b.size
+def v(a):
+    x = PETSc.Vec().createSeq(a.size, comm=PETSc.COMM_SELF); x.array[:] = a; return x
+bc = g.condense(v(b)).copy()
+x = v(np.zeros(b.size)); g.expand(u_c, x)
+y = v(np.zeros(b.size)); g.solve(v(b), y)
+np.savez(folder / "restored.npz", bc=bc, x=x.array, y=y.array)
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       cwd=ROOT, timeout=300)
+    assert r.returncode == 0, r.stderr
+    got = np.load(folder / "restored.npz")
+    bc, x, y = split_solves(f, b, u_c)
+    assert np.array_equal(got["bc"], bc)
+    assert np.array_equal(got["x"], x)
+    assert np.array_equal(got["y"], y)
+    c = SCHUR_DOFS
+    i = np.setdiff1d(np.arange(A.shape[0]), c)
+    Aii = A[i][:, i].tocsc()
+    ref_bc = b[c] - A[c][:, i] @ spla.spsolve(Aii, b[i])
+    assert np.abs(bc - ref_bc).max() <= 1e-11 * np.abs(ref_bc).max()
+    ref_xi = spla.spsolve(Aii, b[i] - A[i][:, c] @ u_c)
+    assert np.abs(x[i] - ref_xi).max() <= 1e-11 * np.abs(ref_xi).max()
+    assert np.array_equal(x[c], u_c)
+    ref = spla.spsolve(A.tocsc(), b)
+    assert np.abs(y - ref).max() <= 1e-11 * np.abs(ref).max()
+
+
+def test_a_schur_factor_needs_its_rows_and_is_refused_when_they_differ(saved_schur):
+    _, _, F, folder, entry, _, _ = saved_schur
+    with pytest.raises(SavedFileError, match="Schur complement; its rows and flexibility"):
+        saved_factor.restore_factor(folder, entry)
+    with pytest.raises(SavedFileError, match="saved with 40 Schur rows, 39 are given"):
+        saved_factor.restore_factor(folder, entry, SCHUR_DOFS[:-1], F[:-1, :-1])
+    cpp = saved_factor._cpp.DistributedSchur
+    with pytest.raises(ValueError, match="1600 rows with a Schur complement on 40 of them, "
+                                         "not 1601 rows and 40"):
+        cpp.restore(str(folder), entry["name"], entry["rows"] + 1, SCHUR_DOFS, F)
+    with pytest.raises(ValueError, match="F\\* is 39 x 39 for 40 Schur rows"):
+        cpp.restore(str(folder), entry["name"], entry["rows"], SCHUR_DOFS, F[:-1, :-1])
+    with pytest.raises(ValueError, match="Schur row 1600 is outside the 1600 rows"):
+        cpp.restore(str(folder), entry["name"], entry["rows"], SCHUR_DOFS + 800, F)
+    # A plain factor's files hold no Schur complement: named, not a crash.
+    A, M = matrix(shift=0.05)
+    plain = tmp = folder / "plain"
+    tmp.mkdir(exist_ok=True)
+    e = saved_factor.save_factor(saved_factor.factor_matrix(M), plain, "k")
+    with pytest.raises(ValueError, match="a Schur complement on 0 of them"):
+        cpp.restore(str(plain), e["name"], e["rows"], SCHUR_DOFS, F)

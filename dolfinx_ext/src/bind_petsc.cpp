@@ -101,6 +101,19 @@ void bind_distributed_schur(py::module& m)
       R"(K factored by MUMPS on several ranks with a Schur complement on the contact DOFs
 (returned by flexibility(K, dofs, "schur") there). Every method is collective.)")
       .def_property_readonly("has_condense", [](const DistributedSchur&) { return true; })
+      .def_property_readonly("size", &DistributedSchur::size, "Rows of K")
+      .def_property_readonly("n_schur", &DistributedSchur::n_schur, "Schur (contact) rows")
+      .def("save", &DistributedSchur::save, py::arg("dir"), py::arg("prefix"),
+           "Write the serial factor as MUMPS's files <dir>/<prefix>_* (JOB=7). Use "
+           "flexcontact.saved_factor, which records and checks the files.")
+      .def_static(
+          "restore",
+          [](const std::string& dir, const std::string& prefix, PetscInt n,
+             const std::vector<PetscInt>& schur, const Eigen::MatrixXd& F)
+          { return DistributedSchur::restore(dir, prefix, n, schur, F); },
+          py::arg("dir"), py::arg("prefix"), py::arg("n"), py::arg("schur"), py::arg("F"),
+          "The serial factor of n rows that save(dir, prefix) wrote (MUMPS JOB=8), with its "
+          "Schur split on the rows `schur` and F* (their flexibility) for the full solves")
       .def("solve", &solve_without_gil<DistributedSchur>, py::arg("b"), py::arg("x"),
            "x = K^-1 b (b, x laid out as K's rows).")
       .def("condense", &condense_without_gil<DistributedSchur>, py::arg("b"),

@@ -51,21 +51,9 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
   // one scatters the solution by MUMPS's elimination order (measured, 7,442 rows: 1.30
   // against 1.37 ms per condensation and expansion).
   distributed_io_ = size_ > 1;
-  id_.job = -1;
-  id_.par = 1; // the host works too
-  id_.sym = 2; // symmetric, LDLᵀ with pivoting, as PETSc's Cholesky of K in serial
-  id_.comm_fortran = static_cast<int>(MPI_Comm_c2f(comm_));
-  dmumps_c(&id_);
-  if (infog(id_, 1) < 0)
-  {
-    release();
-    throw_mumps_error("initialization", infog(id_, 1), infog(id_, 2));
-  }
-  alive_ = true;
+  init_instance();
   try
   {
-    icntl(id_, 1) = icntl(id_, 2) = icntl(id_, 3) = -1; // no printing
-    icntl(id_, 4) = 0;
     icntl(id_, 5) = 0;  // assembled
     icntl(id_, 18) = 3; // distributed triplets
     icntl(id_, 20) = 0; // set per solve (condense_centralised / condense_distributed)
@@ -112,6 +100,89 @@ DistributedSchur::DistributedSchur(Mat K, const std::vector<PetscInt>& schur, in
     release();
     throw;
   }
+}
+
+void DistributedSchur::init_instance()
+{
+  id_.job = -1;
+  id_.par = 1; // the host works too
+  id_.sym = 2; // symmetric, LDLᵀ with pivoting, as PETSc's Cholesky of K in serial
+  id_.comm_fortran = static_cast<int>(MPI_Comm_c2f(comm_));
+  dmumps_c(&id_);
+  if (infog(id_, 1) < 0)
+  {
+    release();
+    throw_mumps_error("initialization", infog(id_, 1), infog(id_, 2));
+  }
+  alive_ = true;
+  icntl(id_, 1) = icntl(id_, 2) = icntl(id_, 3) = -1; // no printing
+  icntl(id_, 4) = 0;
+}
+
+std::shared_ptr<DistributedSchur> DistributedSchur::restore(const std::string& dir,
+                                                            const std::string& prefix,
+                                                            PetscInt n,
+                                                            const std::vector<PetscInt>& schur,
+                                                            const Eigen::MatrixXd& F)
+{
+  const std::string files = "'" + dir + "/" + prefix + "'";
+  if (n < 1 or n > std::numeric_limits<int>::max() - 1)
+    throw std::invalid_argument("DistributedSchur.restore: n=" + std::to_string(n)
+                                + " rows is not a size");
+  if (schur.empty())
+    throw std::invalid_argument("DistributedSchur.restore: no Schur rows given for " + files);
+  for (PetscInt r : schur)
+    if (r < 0 or r >= n)
+      throw std::invalid_argument("DistributedSchur.restore: Schur row " + std::to_string(r)
+                                  + " is outside the " + std::to_string(n) + " rows");
+  const auto n_c = static_cast<Eigen::Index>(schur.size());
+  if (F.rows() != n_c or F.cols() != n_c)
+    throw std::invalid_argument("DistributedSchur.restore: F* is " + std::to_string(F.rows())
+                                + " x " + std::to_string(F.cols()) + " for "
+                                + std::to_string(n_c) + " Schur rows");
+  std::shared_ptr<DistributedSchur> f(new DistributedSchur());
+  f->n_ = n;
+  f->n_c_ = static_cast<int>(n_c);
+  f->schur_rows_ = schur;
+  f->rend_ = n;
+  f->distributed_io_ = false; // one rank: the centralised solves are plain copies
+  MPI_Comm_dup(MPI_COMM_SELF, &f->comm_);
+  f->init_instance();
+  set_save_files(f->id_, dir, prefix, "DistributedSchur");
+  f->call(8, ("restoration of " + files).c_str());
+  icntl(f->id_, 1) = icntl(f->id_, 2) = icntl(f->id_, 3) = -1; // the saved ones came back
+  icntl(f->id_, 4) = 0;
+  if (f->id_.n != static_cast<int>(n) or icntl(f->id_, 19) == 0
+      or f->id_.size_schur != f->n_c_)
+    throw std::invalid_argument(
+        "DistributedSchur.restore: the files at " + files + " hold a factor of "
+        + std::to_string(f->id_.n) + " rows with a Schur complement on "
+        + std::to_string(icntl(f->id_, 19) == 0 ? 0 : f->id_.size_schur) + " of them, not "
+        + std::to_string(n) + " rows and " + std::to_string(n_c));
+  // MUMPS keeps the Schur variables' order from the analysis; the list is set again as the
+  // constructor sets it, so the instance is in the state the factoring one was in.
+  f->listvar_.resize(n_c);
+  for (Eigen::Index k = 0; k < n_c; ++k)
+    f->listvar_[k] = static_cast<int>(schur[k] + 1);
+  f->id_.listvar_schur = f->listvar_.data();
+  f->stats_.infog7 = infog(f->id_, 7);
+  const int e20 = infog(f->id_, 20);
+  f->stats_.factor_entries = e20 >= 0 ? e20 : -static_cast<std::int64_t>(e20) * 1000000;
+  f->schur_.assign(static_cast<std::size_t>(n_c) * n_c, 0.0);
+  f->set_flexibility(F);
+  return f;
+}
+
+void DistributedSchur::save(const std::string& dir, const std::string& prefix)
+{
+  if (!alive_)
+    throw std::runtime_error("DistributedSchur.save: the factor was released");
+  if (size_ != 1)
+    throw std::invalid_argument("DistributedSchur.save: the factor is distributed over "
+                                + std::to_string(size_) + " processes; only a serial one "
+                                "is saved");
+  set_save_files(id_, dir, prefix, "DistributedSchur");
+  call(7, ("save to '" + dir + "/" + prefix + "'").c_str());
 }
 
 void DistributedSchur::factorize()

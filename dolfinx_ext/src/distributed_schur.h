@@ -22,6 +22,10 @@
 /// the host. The centralised variant (ICNTL(20) = ICNTL(21) = 0: b gathered on rank 0, the
 /// solution scattered back from it) stays selectable (set_distributed_io) and is taken
 /// automatically if MUMPS refuses the distributed one (its INFOG(1) in io_refusal()).
+///
+/// On one rank the factor can be written to files (save(), MUMPS's JOB=7) and read back in
+/// another process (restore(), JOB=8) with its Schur split: the restored instance condenses
+/// and expands as the one that factored (docs/architecture.md §7, "A factor kept on disk").
 
 #include "flexcontact/block_flexibility.hpp"
 
@@ -71,14 +75,27 @@ public:
   DistributedSchur(Mat K, const std::vector<PetscInt>& schur, int icntl7,
                    std::vector<int> perm_in);
   ~DistributedSchur();
+  /// @brief The serial factor that save(dir, prefix) wrote for a matrix of n rows, on
+  /// MPI_COMM_SELF, with its Schur complement on `schur` (the rows it was factored with, in
+  /// that order) and F* (n_c × n_c) for the full solves. The factorization is not redone.
+  /// @throws MumpsError naming the files, std::invalid_argument if the files hold another
+  ///   size or Schur size
+  static std::shared_ptr<DistributedSchur> restore(const std::string& dir,
+                                                   const std::string& prefix, PetscInt n,
+                                                   const std::vector<PetscInt>& schur,
+                                                   const Eigen::MatrixXd& F);
   DistributedSchur(const DistributedSchur&) = delete;
   DistributedSchur& operator=(const DistributedSchur&) = delete;
 
   /// @brief Free MUMPS's instance (job = -2) and the PETSc objects; collective; idempotent.
   void release();
 
+  /// @brief Write the factor as MUMPS's files `<dir>/<prefix>_*` (JOB=7). One rank only.
+  void save(const std::string& dir, const std::string& prefix);
+
   const DistributedFactorStats& stats() const { return stats_; }
   int n_schur() const { return n_c_; }
+  PetscInt size() const { return n_; }
 
   /// @brief Rank 0: K*_cc as a dense column-major n_c × n_c array (both triangles).
   const double* schur_complement();
@@ -111,6 +128,8 @@ public:
   const DistributedSolveTimes& last_times() const { return times_; }
 
 private:
+  DistributedSchur() = default; // restore()'s
+  void init_instance();
   void call(int job, const char* phase);
   void factorize();
   void scatter_back(const double* host, Vec x);

@@ -7,6 +7,8 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cstring>
+#include <stdexcept>
 
 void flexcontact::upper_triplets(Mat K, std::vector<int>& irn, std::vector<int>& jcn,
                                  std::vector<double>& a)
@@ -54,6 +56,20 @@ int flexcontact::factorize_growing_workspace(DMUMPS_STRUC_C& id)
       throw_mumps_error("factorization", e, id.infog[1]);
     return retries;
   }
+}
+
+void flexcontact::set_save_files(DMUMPS_STRUC_C& id, const std::string& dir,
+                                 const std::string& prefix, const std::string& who)
+{
+  if (dir.size() >= sizeof(id.save_dir) or prefix.size() >= sizeof(id.save_prefix))
+    throw std::invalid_argument(who + ": the folder '" + dir + "' or the prefix '" + prefix
+                                + "' is longer than MUMPS takes ("
+                                + std::to_string(sizeof(id.save_dir) - 1) + " and "
+                                + std::to_string(sizeof(id.save_prefix) - 1) + " characters)");
+  std::memset(id.save_dir, 0, sizeof(id.save_dir));
+  std::memset(id.save_prefix, 0, sizeof(id.save_prefix));
+  std::memcpy(id.save_dir, dir.data(), dir.size());
+  std::memcpy(id.save_prefix, prefix.data(), prefix.size());
 }
 
 void flexcontact::end_instance(DMUMPS_STRUC_C& id, bool& alive)

@@ -9,7 +9,6 @@
 #include <mpi.h>
 
 #include <algorithm>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -90,7 +89,7 @@ SavedFactor::SavedFactor(const std::string& dir, const std::string& prefix, Pets
   init();
   try
   {
-    set_files(dir, prefix);
+    set_save_files(id_, dir, prefix, "SavedFactor");
     call(8, "restoration of '" + dir + "/" + prefix + "'");
     if (id_.n != static_cast<int>(n_))
       throw std::invalid_argument("SavedFactor: the files at '" + dir + "/" + prefix
@@ -111,24 +110,11 @@ void SavedFactor::release()
   end_instance(id_, alive_);
 }
 
-void SavedFactor::set_files(const std::string& dir, const std::string& prefix)
-{
-  if (dir.size() >= sizeof(id_.save_dir) or prefix.size() >= sizeof(id_.save_prefix))
-    throw std::invalid_argument("SavedFactor: the folder '" + dir + "' or the prefix '" + prefix
-                                + "' is longer than MUMPS takes ("
-                                + std::to_string(sizeof(id_.save_dir) - 1) + " and "
-                                + std::to_string(sizeof(id_.save_prefix) - 1) + " characters)");
-  std::memset(id_.save_dir, 0, sizeof(id_.save_dir));
-  std::memset(id_.save_prefix, 0, sizeof(id_.save_prefix));
-  std::memcpy(id_.save_dir, dir.data(), dir.size());
-  std::memcpy(id_.save_prefix, prefix.data(), prefix.size());
-}
-
 void SavedFactor::save(const std::string& dir, const std::string& prefix)
 {
   if (!alive_)
     throw std::runtime_error("SavedFactor: the factor was released");
-  set_files(dir, prefix);
+  set_save_files(id_, dir, prefix, "SavedFactor");
   call(7, "save to '" + dir + "/" + prefix + "'");
 }
 

@@ -48,7 +48,6 @@ public:
 private:
   void init();
   void call(int job, const std::string& phase);
-  void set_files(const std::string& dir, const std::string& prefix);
 
   DMUMPS_STRUC_C id_{};
   bool alive_ = false;

@@ -6,17 +6,27 @@ each file's size and SHA-256, the matrix size and the MUMPS version; :func:`rest
 checks all of it before MUMPS reads a byte (a truncated or altered file would otherwise stop
 the process inside MUMPS's Fortran reader) and restores the factor (JOB=8). The restored
 object has ``solve(b, x)``, so the steppers take it like any factor.
+
+Two kinds are saved: a plain factor (``SavedFactor``) and a factor with a Schur complement
+on a body's contact DOFs (the ``DistributedSchur`` that ``flexibility(K, dofs, "schur")``
+returns on one rank; its entry says ``"kind": "schur"``). The latter comes back with its
+split — ``condense`` and ``expand``, one partial solve each — given its Schur rows and F*.
 """
 from __future__ import annotations
 
 import hashlib
 from pathlib import Path
 
+import numpy as np
+
 from . import _cpp
 from .errors import SavedFileError
 
 FACTOR_FORMAT = 1
 """The manifest entry's format (the files' own format is MUMPS's, tied to its version)."""
+
+SCHUR = "schur"
+"""The entry's "kind" of a factor saved with its Schur complement (a DistributedSchur)."""
 
 
 def sha256(path: Path) -> str:
@@ -33,8 +43,10 @@ def factor_matrix(A) -> "_cpp.SavedFactor":
 
 
 def save_factor(factor, folder, name: str) -> dict:
-    """Write ``factor`` (a SavedFactor) as ``folder/name_*`` and return its manifest entry:
-    {"name", "rows", "mumps_version", "format", "files": {file: {"bytes", "sha256"}}}."""
+    """Write ``factor`` (a SavedFactor, or a serial DistributedSchur) as ``folder/name_*``
+    and return its manifest entry: {"name", "rows", "mumps_version", "format", "files":
+    {file: {"bytes", "sha256"}}}, and for a DistributedSchur "kind": "schur" and
+    "schur_rows" (how many)."""
     folder = Path(folder)
     before = {p.name for p in folder.iterdir()}
     factor.save(str(folder), name)
@@ -42,9 +54,12 @@ def save_factor(factor, folder, name: str) -> dict:
                    and p.name.startswith(name + "_"))
     if not files:
         raise SavedFileError(f"{folder}/{name}: MUMPS wrote no file")
-    return {"name": name, "rows": int(factor.size), "format": FACTOR_FORMAT,
-            "mumps_version": _cpp.mumps_version,
-            "files": {p.name: {"bytes": p.stat().st_size, "sha256": sha256(p)} for p in files}}
+    entry = {"name": name, "rows": int(factor.size), "format": FACTOR_FORMAT,
+             "mumps_version": _cpp.mumps_version,
+             "files": {p.name: {"bytes": p.stat().st_size, "sha256": sha256(p)} for p in files}}
+    if isinstance(factor, _cpp.DistributedSchur):
+        entry.update(kind=SCHUR, schur_rows=int(factor.n_schur))
+    return entry
 
 
 def check_factor_files(folder, entry: dict) -> None:
@@ -71,7 +86,19 @@ def check_factor_files(folder, entry: dict) -> None:
                                  "was altered)")
 
 
-def restore_factor(folder, entry: dict) -> "_cpp.SavedFactor":
-    """The factor that :func:`save_factor` wrote (checked first, then one restoration)."""
+def restore_factor(folder, entry: dict, schur_dofs=None, flexibility=None):
+    """The factor that :func:`save_factor` wrote (checked first, then one restoration). A
+    factor saved with its Schur complement needs ``schur_dofs`` (its rows, in the order it
+    was factored with) and ``flexibility`` (F* on them, for full solves)."""
     check_factor_files(folder, entry)
-    return _cpp.SavedFactor.restore(str(Path(folder)), entry["name"], int(entry["rows"]))
+    if entry.get("kind") != SCHUR:
+        return _cpp.SavedFactor.restore(str(Path(folder)), entry["name"], int(entry["rows"]))
+    if schur_dofs is None or flexibility is None:
+        raise SavedFileError(f"{folder}: factor '{entry['name']}' has a Schur complement; "
+                             "its rows and flexibility are needed to restore it")
+    dofs = np.asarray(schur_dofs, np.int64).reshape(-1)
+    if dofs.size != entry["schur_rows"]:
+        raise SavedFileError(f"{folder}: factor '{entry['name']}' was saved with "
+                             f"{entry['schur_rows']} Schur rows, {dofs.size} are given")
+    return _cpp.DistributedSchur.restore(str(Path(folder)), entry["name"], int(entry["rows"]),
+                                         dofs, np.asarray(flexibility, float))
