@@ -140,26 +140,29 @@ ASKED_3D = {"log_speed_m_s": 3.0, "log_yaw_deg": 10.0, "log_across_m": 6.5}
 def test_a_3d_model_answers_in_a_new_process_as_the_factoring_evaluator(tmp_path):
     """The 3D block: prepare (keeping the base's log), then what-if in a new process with a
     yaw and a place across the block; the same answer as the evaluator that factored the
-    dam and the log (1e-10), the dam's factors and the log's restored, none made; a log
-    leaving the saved patch is refused by name."""
+    dam and the log (1e-10), the dam's factors and the log's restored, none made, Ŵ with its
+    Schur split; a log leaving the saved patch is refused by name."""
     dt = sweep_time_step_s([BASE_3D])
     levels = (BASE_3D.water_level_m, BASE_3D.water_level_m)
     path = tmp_path / "dam3d"
     manifest = model_file.prepare(BASE_3D, dt, levels, path, lags=0, progress=lambda *a: None,
                                   logs=[BASE_3D])
     assert manifest["inputs"]["patch_y_m"][0] > 0.0
-    assert "kind" not in manifest["factors"]["stage2"]  # the 3D block: MUMPS's files
+    assert manifest["factors"]["stage2"]["kind"] == "schur"  # MUMPS's files, split kept
     assert len(manifest["logs"]) == 1
     r = cli("what-if", path, *[a for k, v in ASKED_3D.items()
                                for a in ("--" + k.replace("_", "-"), v)], "--json")
     assert r.returncode == 0, r.stderr
     got = json.loads(r.stdout)
-    ref = ScenarioEvaluator(BASE_3D, dt, levels, MPI.COMM_SELF).evaluate(
-        BASE_3D.replace(**ASKED_3D))
+    own = ScenarioEvaluator(BASE_3D, dt, levels, MPI.COMM_SELF)
+    ref = own.evaluate(BASE_3D.replace(**ASKED_3D))
     for key in OUTPUTS:
         assert got["outputs"][key] == pytest.approx(ref[key], rel=1e-10), key
     c = got["counts"]
     assert c["factorizations"] == {"dam_stage1": 0, "dam_stage2": 0, "log": 0}
     assert c["restorations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 1}
+    # The restored Ŵ kept its Schur split: a contact step is one condensation and one
+    # expansion of the dam, as with its own factor, not two whole solves.
+    assert c["back_substitutions"]["dam_stage2"] == own.counts()["back_substitutions"]["dam_stage2"]
     r = cli("what-if", path, "--log-across-m", 13.0)
     assert r.returncode == 2 and "face patch" in r.stderr, r.stderr

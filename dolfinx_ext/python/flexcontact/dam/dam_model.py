@@ -157,9 +157,9 @@ class DamModel:
         # "face_compliance_x": array} read from a model file (dam/model_file.py): nothing is
         # factored, the restorations are counted instead.
         self._restored = restored
-        # saveable: K and Ŵ factored as SavedFactors (model_file.prepare writes them, no
-        # second factorization); Ŵ then has no Schur split, and W_face comes from its solves,
-        # unless Ŵ is small enough for the split factor, whose arrays are saved instead.
+        # saveable: K factored as a SavedFactor (model_file.prepare writes it, no second
+        # factorization). Ŵ's factors can be saved either way: MUMPS's Schur factor
+        # (DistributedSchur) writes its files with its split, the split factor its arrays.
         self._saveable = bool(saveable) and restored is None
         self._compliance = ({0: restored["face_compliance_x"]}
                             if restored is not None and "face_compliance_x" in restored else {})
@@ -266,7 +266,8 @@ class DamModel:
                 raise SolveError(f"W_face of shape {self.W_face.shape} restored for a face of "
                                  f"{self.face_dofs.size} DOFs")
             self.restorations["dam_stage2"] += 1
-            self.flex_info = {"restored": True}
+            self.flex_info = {"restored": True,
+                              "split": bool(getattr(self.factor, "has_condense", False))}
         elif SplitFactor.worth_it(self.W_hat.getSize()[0]):
             # A small dam (the 2D section): MUMPS's set-up per solve would be most of a step.
             # Its arrays are what a model file keeps, so a saveable model takes it too.
@@ -274,34 +275,12 @@ class DamModel:
             self.W_face = self.factor.W
             self.factorizations["dam_stage2"] += 1
             self.flex_info = {"factor": "split", "factor_entries": self.factor.factor_entries}
-        elif self._saveable:
-            from ..saved_factor import factor_matrix
-            self.factor = factor_matrix(self.W_hat)
-            self.factorizations["dam_stage2"] += 1
-            self.W_face = self._flexibility_by_solves()
-            self.flex_info = {"saveable": True, "solves": int(self.face_dofs.size)}
         else:
             F, self.factor, info = _cpp.flexibility(self.W_hat, self.face_dofs, "schur")
             self.W_face = np.asarray(F)
             self.factorizations["dam_stage2"] += int(info["factorizations"])
             self.flex_info = dict(info)
         self.timings["stage2_factor_s"] = time.perf_counter() - t0
-
-    def _flexibility_by_solves(self) -> np.ndarray:
-        """W_face = S Ŵ⁻¹ Sᵀ column by column, one back-substitution per face DOF (counted
-        in "dam_stage2"), symmetrised."""
-        dofs = self.face_dofs
-        e, x = self.new_vector(), self.new_vector()
-        W = np.empty((dofs.size, dofs.size))
-        for j, i in enumerate(dofs):
-            e.zeroEntries()
-            e.array[i] = 1.0
-            self.factor.solve(e, x)
-            W[:, j] = x.array_r[dofs]
-        self.back_substitutions["dam_stage2"] += int(dofs.size)
-        e.destroy()
-        x.destroy()
-        return 0.5 * (W + W.T)
 
     def _strip_tags(self):
         """MeshTags of the upstream-face facets inside the strip (their midpoints)."""

@@ -10,7 +10,9 @@ The model is one directory, written atomically (complete or absent):
   functions (dam/response.py), the face compliance of the re-contact bound, and the static
   displacement of each water level it was asked for;
 * MUMPS's own files of the two factors, K (stage 1: another water level in the range is one
-  back-substitution) and Ŵ (stage 2), written and checked by flexcontact.saved_factor; a Ŵ
+  back-substitution) and Ŵ (stage 2, with its Schur complement on the face, so that a
+  restored dam condenses and expands as the one that factored it), written and checked by
+  flexcontact.saved_factor; a Ŵ
   small enough for the sparse split factor (the 2D section, split_factor.SPLIT_LIMIT) is
   kept in ``arrays.npz`` instead (its pivot order and Cholesky factor), so that a restored
   2D dam condenses and expands as the one that factored it.
@@ -210,8 +212,11 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
     base = DamScenario.from_dict(inputs["base"])
     with np.load(path / "arrays.npz") as z:
         arrays = {k: z[k] for k in z.files}
+    # Ŵ's MUMPS factor comes back with its Schur split on the face (kind "schur"); a plain
+    # factor (K, or Ŵ of a model saved without the split) ignores the face's arrays.
     restored = {name: (SplitFactor.from_arrays(arrays, name + "_") if entry.get("kind") == SPLIT
-                       else saved_factor.restore_factor(path, entry))
+                       else saved_factor.restore_factor(path, entry, arrays["face_dofs"],
+                                                        arrays["W_face"]))
                 for name, entry in manifest["factors"].items()}
     restored["W_face"] = arrays["W_face"]
     restored["face_compliance_x"] = arrays["face_compliance_x"]

@@ -20,8 +20,9 @@ def prepare(cfg: SweepConfig) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
     import), the sweep's time step and water levels, and, with engine.model for the "reuse"
     evaluator, the dam model every worker loads (prepared there once if it is not
-    there yet). Without engine.model each worker factors the dam itself: in 2D that is
-    faster per step, since a restored factor has no Schur split (bench/README.md)."""
+    there yet). Without engine.model each worker factors the dam itself and computes its
+    response functions; a restored dam steps as fast as its own factor, in 2D and 3D
+    (bench/README.md)."""
     base, points, scenarios = build_scenarios(cfg)
     cls, _ = evaluators.resolve(cfg.engine["evaluator"])
     dt = evaluators.sweep_time_step(cfg.engine["evaluator"], scenarios)
