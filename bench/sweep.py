@@ -35,6 +35,9 @@ def main():
     ap.add_argument("--engine", choices=("serial", "processes", "mpi", "dask"), default=None)
     ap.add_argument("--evaluator", default=None, help="overrides engine.evaluator")
     ap.add_argument("--n", type=int, default=None, help="overrides sample.n (a trial run)")
+    ap.add_argument("--model", default=None,
+                    help="engine.model: a dam model directory the workers load (prepared "
+                         "there first if absent)")
     ap.add_argument("--out", default="results/bench_sweep")
     ap.add_argument("--keep", action="store_true", help="resume the folder instead of clearing it")
     ap.add_argument("--json", default=str(here / "sweep.json"), help="where the timings go")
@@ -46,7 +49,7 @@ def main():
     if args.n is not None:
         raw["sample"]["n"] = args.n
     for key, value in (("workers", args.workers), ("kind", args.engine),
-                       ("evaluator", args.evaluator)):
+                       ("evaluator", args.evaluator), ("model", args.model)):
         if value is not None:
             raw.setdefault("engine", {})[key] = value
     cfg = sweep.from_dict(raw, source=args.config)
