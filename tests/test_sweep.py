@@ -454,6 +454,14 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     with pytest.raises(ConfigError, match="crest_width_m=6.0"):
         sweep.run(sweep.from_dict(raw), out=tmp_path / "other")
     assert not (tmp_path / "other" / "results.jsonl").exists()
+    # The same dam with a shorter log: the sample's time step changed, and the error says
+    # that it is the sample's, not the dam's.
+    del raw["base"]
+    raw["parameters"]["log_length_m"] = {"values": [6.0]}
+    with pytest.raises(ConfigError, match="time step .* differs from the model's .*"
+                                          "follows from the sampled scenarios"):
+        sweep.run(sweep.from_dict(raw), out=tmp_path / "shorter")
+    assert not (tmp_path / "shorter" / "results.jsonl").exists()
 
 
 def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):

@@ -65,7 +65,18 @@ def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = 
                                           **(face or {}))
         else:
             manifest = model_file.read_manifest(path)
-            model_file.check_inputs(manifest, base, dt)
+            model_file.check_inputs(manifest, base)
+            saved_dt = manifest["inputs"]["dt_s"]
+            if float(dt) != saved_dt:
+                # The step is the sample's, not the dam's: say so, or a trial with another n
+                # looks like a broken model.
+                raise ConfigError(
+                    f"engine.model={str(path)!r}: the sweep's time step {dt:.6g} s differs "
+                    f"from the model's {saved_dt:.6g} s. The step follows from the sampled "
+                    "scenarios (the shortest log wave round trip over 40 steps, "
+                    "stage2.sweep_time_step_s), so another sample (sample.n or seed, or "
+                    "the ranges of log length, wood density or added mass) has another: "
+                    "point engine.model at a new directory to prepare a model for this one")
     except SavedFileError as e:
         raise ConfigError(f"engine.model={str(path)!r}: {e}") from None
     lo, hi = manifest["inputs"]["water_levels_m"]
