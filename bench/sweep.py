@@ -12,6 +12,11 @@ bench/sweep.json (with the machine's description); ``--config bench/sweep_1000_3
 
     /usr/bin/python3 bench/sweep.py [--config bench/sweep_1000.toml] [--workers 2]
         [--evaluator reuse|monolithic] [--n N]     # --n: a smaller trial of the same sweep
+        [--model DIR | --own-factors]
+
+The folder is cleared first (unless --keep), so by default the dam model is prepared in the
+run, as a first sweep prepares it; --model DIR with a model there measures a sweep that
+reuses one, --own-factors one whose workers each factor the dam.
 """
 import argparse
 import json
@@ -37,7 +42,10 @@ def main():
     ap.add_argument("--n", type=int, default=None, help="overrides sample.n (a trial run)")
     ap.add_argument("--model", default=None,
                     help="engine.model: a dam model directory the workers load (prepared "
-                         "there first if absent)")
+                         "there first if absent; default: dam_model/ in --out, prepared "
+                         "in the run)")
+    ap.add_argument("--own-factors", action="store_true",
+                    help="engine.model = false: every worker factors the dam itself")
     ap.add_argument("--out", default="results/bench_sweep")
     ap.add_argument("--keep", action="store_true", help="resume the folder instead of clearing it")
     ap.add_argument("--json", default=str(here / "sweep.json"), help="where the timings go")
@@ -52,6 +60,8 @@ def main():
                        ("evaluator", args.evaluator), ("model", args.model)):
         if value is not None:
             raw.setdefault("engine", {})[key] = value
+    if args.own_factors:
+        raw.setdefault("engine", {})["model"] = False
     cfg = sweep.from_dict(raw, source=args.config)
     out = Path(args.out)
     if out.exists() and not args.keep:

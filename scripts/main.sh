@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Install what is needed, build, and run the main job: the dam–log impact demo (outputs in
 # results/dam_debris/), then a short sweep of 32 impact scenarios on the 3D dam block (outputs
-# in results/sweep/sweep_3d/; run again after an interruption, it resumes).
+# in results/sweep/sweep_3d/, with the dam model it prepares once in dam_model/ there; run
+# again after an interruption, it resumes).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bash "$here/scripts/setup.sh"

@@ -9,6 +9,7 @@ on the default (smallest) dam mesh.
 import json
 import math
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -123,6 +124,7 @@ BAD = [
     ({"base": {"dam_hight_m": 30.0}}, ["base.dam_hight_m=30.0", "unknown"]),
     ({"base": {"water_level_m": 40.0}}, ["water_level_m=40.0", "overtopped"]),
     ({"engine": {"kind": "cluster"}}, ["engine.kind", "'cluster'"]),
+    ({"engine": {"model": True}}, ["engine.model=True", "or false"]),
     ({"engine": {"evaluator": "no_such_module:Evaluator"}},
      ["engine.evaluator", "no_such_module"]),
     ({"output": {"band": 1.5}}, ["output.band=1.5"]),
@@ -421,16 +423,17 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     """Over speeds, pitch angles, friction and water levels on one dam mesh and one log
     geometry, the reusing evaluator factors K (stage 1) and K_eff (stage 2) once each, plus
     the log's own factorization: three in all, whatever the number of scenarios (serial:
-    one evaluator). With a dam model (engine.model) it is prepared once (K and K_eff
-    factored once each, as the factors it saves, and the log's model kept), the evaluator
-    restores both factors and the log and factors nothing, and the table is the same to
-    1e-10."""
+    one evaluator; engine.model = false). With a dam model (engine.model) it is prepared
+    once (K and K_eff factored once each, as the factors it saves, and the log's model
+    kept), the evaluator restores both factors and the log and factors nothing, and the
+    table is the same to 1e-10."""
     pytest.importorskip("flexcontact.dam.reuse")
     raw = {"parameters": {"log_speed_m_s": {"values": [1.5, 3.0]},
                           "log_pitch_deg": {"values": [5.0, 10.0]},
                           "friction_mu": {"values": [0.3, 0.6]},
                           "water_level_m": {"values": [26.0, 27.0]}},
-           "engine": {"evaluator": "reuse", "kind": "serial"}, "output": {"plots": False}}
+           "engine": {"evaluator": "reuse", "kind": "serial", "model": False},
+           "output": {"plots": False}}
     own = sweep.run(sweep.from_dict(raw), out=tmp_path / "own")
     assert own["scenarios"] == 16
     assert own["counts"]["factorizations"]["total"] == 3, own["counts"]
@@ -464,10 +467,54 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     assert not (tmp_path / "shorter" / "results.jsonl").exists()
 
 
+def test_default_model_is_the_sweeps_own_prepared_once_and_replaced_if_stale(tmp_path):
+    """Without engine.model the "reuse" sweep prepares its dam model in its output folder
+    (dam_model/) and its evaluator factors nothing; run again, it reuses it. A changed
+    config is refused by the table before any model is prepared. A stale model in that
+    folder (here one of another time step) is prepared again, and the summary says why."""
+    pytest.importorskip("flexcontact.dam.reuse")
+    raw = {"parameters": {"log_speed_m_s": {"values": [1.5, 3.0]},
+                          "log_length_m": {"values": [8.0]}},
+           "engine": {"evaluator": "reuse", "kind": "serial"}, "output": {"plots": False}}
+    out = tmp_path / "out"
+    s = sweep.run(sweep.from_dict(raw), out=out)
+    assert s["dam_model"]["path"] == str(out / "dam_model")
+    assert s["dam_model"]["prepared_this_run"] and "replaced" not in s["dam_model"]
+    assert s["counts"]["factorizations"]["total"] == 0, s["counts"]
+    manifest = (out / "dam_model" / "manifest.json").read_bytes()
+    again = sweep.run(sweep.from_dict(raw), out=out)
+    assert again["computed_this_run"] == 0 and not again["dam_model"]["prepared_this_run"]
+    changed = {**raw, "parameters": {**raw["parameters"],
+                                     "log_speed_m_s": {"values": [1.0, 3.0]}}}
+    with pytest.raises(TableError, match="config changed"):
+        sweep.run(sweep.from_dict(changed), out=out)
+    assert (out / "dam_model" / "manifest.json").read_bytes() == manifest
+    # The same model under a sweep of a longer log: another time step, so prepared again.
+    longer = {**raw, "parameters": {**raw["parameters"], "log_length_m": {"values": [12.0]}}}
+    shutil.copytree(out / "dam_model", tmp_path / "longer" / "dam_model")
+    s = sweep.run(sweep.from_dict(longer), out=tmp_path / "longer")
+    assert s["dam_model"]["prepared_this_run"]
+    assert "time step" in s["dam_model"]["replaced"]
+    assert "It replaced this sweep's earlier model" in (tmp_path / "longer" /
+                                                         "report.md").read_text()
+    m = json.loads((tmp_path / "longer" / "dam_model" / "manifest.json").read_text())
+    assert m["inputs"]["dt_s"] == pytest.approx(s["dt_s"], rel=0)
+    # --no-model: the (serial) evaluator factors K, K_eff and the log itself.
+    cfg = write_toml(tmp_path / "own.toml", raw)
+    proc = subprocess.run([sys.executable, "-m", "flexcontact", "sweep", str(cfg), "--out",
+                           str(tmp_path / "own"), "--no-model"], capture_output=True,
+                          text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    own = json.loads((tmp_path / "own" / "summary.json").read_text())
+    assert "dam_model" not in own and not (tmp_path / "own" / "dam_model").exists()
+    assert own["counts"]["factorizations"]["total"] == 3, own["counts"]
+
+
 def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):
     """The 3D block: a grid over yaw and the log's place across the block, on the dam
-    block's face patch that holds them all. Three factorizations in all (K, K_eff of the
-    block, the round log); every scenario's impulse is the log's loss of momentum along x
+    block's face patch that holds them all. The sweep's dam model factors K and K_eff of
+    the block once each, and the round log; the evaluator restores the three and factors
+    nothing. Every scenario's impulse is the log's loss of momentum along x
     (1e-9); the report speaks of the 3D block and of totals, not per metre. With
     --check-convergence the worst are re-run by the monolithic evaluator at refine + 1, whose
     impulse is again the log's loss of momentum (1e-9). (Measured: the worst filtered peak
@@ -479,7 +526,10 @@ def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):
            "engine": {"evaluator": "reuse", "kind": "serial"}, "output": {"plots": False}}
     s = sweep.run(sweep.from_dict(raw), out=tmp_path / "out", check_convergence=True)
     assert s["scenarios"] == 4
-    assert s["counts"]["factorizations"]["total"] == 3, s["counts"]
+    assert s["counts"]["factorizations"]["total"] == 0, s["counts"]
+    assert s["counts"]["restorations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 1,
+                                           "total": 3}, s["counts"]
+    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1}
     c = s["convergence"]["peak_force_filtered_N_per_m"]
     assert c["evaluator_refined"] == "monolithic" and c["refine"] == 0
     fine = c["outputs_refined"]

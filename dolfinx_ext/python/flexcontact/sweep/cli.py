@@ -17,9 +17,13 @@ def add_parser(sub) -> None:
     p.add_argument("--engine", choices=ENGINES, help="overrides engine.kind")
     p.add_argument("--workers", type=int, help="overrides engine.workers")
     p.add_argument("--scheduler", help="Dask scheduler address (engine dask)")
-    p.add_argument("--model", help="a dam model directory (flexcontact dam prepare) every "
+    m = p.add_mutually_exclusive_group()
+    m.add_argument("--model", help="a dam model directory (flexcontact dam prepare) every "
                                    "worker loads instead of factoring the dam; prepared "
-                                   "there once if absent (engine.model)")
+                                   "there once if absent (engine.model; default: "
+                                   "dam_model/ in the output folder)")
+    m.add_argument("--no-model", action="store_true",
+                   help="every worker factors the dam itself (engine.model = false)")
     p.add_argument("--check-convergence", action="store_true",
                    help="rerun each output's most unfavourable scenario at refine + 1")
 
@@ -45,6 +49,8 @@ def main(args) -> int:
                 cfg.engine[key] = getattr(args, key)
         if getattr(args, "model", None):
             cfg.engine["model"] = args.model
+        elif getattr(args, "no_model", False):
+            cfg.engine["model"] = False
         if args.engine:
             cfg.engine["kind"] = args.engine
         elif args.scheduler:

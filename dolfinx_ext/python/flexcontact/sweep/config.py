@@ -176,9 +176,10 @@ def check_engine(e: dict) -> None:
         _int("engine.workers", e["workers"], 1)
     if e["scheduler"] is not None and not isinstance(e["scheduler"], str):
         raise ConfigError(f"engine.scheduler={e['scheduler']!r}: must be an address string")
-    if e.get("model") is not None and not (isinstance(e["model"], str) and e["model"]):
-        raise ConfigError(f"engine.model={e['model']!r}: must be the path of a dam model "
-                          "directory")
+    m = e.get("model")
+    if m is not None and m is not False and not (isinstance(m, str) and m):
+        raise ConfigError(f"engine.model={m!r}: must be the path of a dam model directory, "
+                          "or false for every worker to factor the dam itself")
     if e["start_method"] not in ("spawn", "forkserver"):
         raise ConfigError(f"engine.start_method={e['start_method']!r}: must be 'spawn' or "
                           f"'forkserver'")

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import shutil
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -16,13 +17,20 @@ from .scenarios import build_scenarios, point_hash
 from .table import ResultTable
 
 
-def prepare(cfg: SweepConfig) -> dict:
+DEFAULT_MODEL = "dam_model"
+"""The folder, inside a sweep's output folder, of the dam model the "reuse" evaluator's
+workers load when engine.model is not given."""
+
+
+def prepare(cfg: SweepConfig, folder: Optional[Path] = None) -> dict:
     """Everything decided before computing: scenarios (all checked), the evaluator (it must
-    import), the sweep's time step and water levels, and, with engine.model for the "reuse"
-    evaluator, the dam model every worker loads (prepared there once if it is not
-    there yet). Without engine.model each worker factors the dam itself and computes its
-    response functions; a restored dam steps as fast as its own factor, in 2D and 3D
-    (bench/README.md)."""
+    import), the sweep's time step and water levels, and, for the "reuse" evaluator, the dam
+    model every worker loads instead of factoring the dam: engine.model, or by default
+    ``folder/dam_model``, prepared there once if it is not there yet, so that a resumed or
+    repeated sweep factors nothing of the dam. ``engine.model = false`` has each worker
+    factor the dam and compute its response functions itself (the driving process too, to
+    check the scenarios): cheaper only for a few scenarios on the 3D block
+    (docs/dam.md, "Sweeps")."""
     base, points, scenarios = build_scenarios(cfg)
     cls, _ = evaluators.resolve(cfg.engine["evaluator"])
     dt = evaluators.sweep_time_step(cfg.engine["evaluator"], scenarios)
@@ -36,24 +44,50 @@ def prepare(cfg: SweepConfig) -> dict:
                          face=face)
     prep = {"base": base, "points": points, "scenarios": scenarios, "spec": spec, "dt_s": dt,
             "checker": None}
-    model = cfg.engine.get("model")
-    if cfg.engine["evaluator"] == "reuse" and model is not None:
-        prep["model"] = dam_model(Path(model), base, dt, levels, face, scenarios)
-        spec = prep["spec"] = replace(spec, model=str(model))
+    model, owned = model_path(cfg, folder)
+    if model is not None:
+        if owned:
+            # A changed config is the table's refusal to make, before a model is prepared
+            # for a sweep that will not run.
+            ResultTable(folder, cfg.hash(), [point_hash(p) for p in points]).check()
+        prep["model"] = dam_model(model, base, dt, levels, face, scenarios, owned=owned)
+        spec = prep["spec"] = replace(spec, model=str(model.resolve()))
     if hasattr(cls, "check"):
         prep["checker"] = check_all(spec, points, scenarios)
     return prep
 
 
+def model_path(cfg: SweepConfig, folder: Optional[Path]) -> tuple:
+    """(the dam model directory the workers load or None, whether it is the sweep's own:
+    ``folder/dam_model``, which this sweep may replace)."""
+    m = cfg.engine.get("model")
+    if cfg.engine["evaluator"] != "reuse" or m is False:
+        return None, False
+    if m is not None:
+        return Path(m), False
+    if folder is None:
+        return None, False
+    return Path(folder) / DEFAULT_MODEL, True
+
+
 def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = None,
-              scenarios=()) -> dict:
+              scenarios=(), owned: bool = False) -> dict:
     """The dam model at ``path`` for this sweep: prepared there once (atomically) if absent,
     else checked against the sweep's dam and time step (ConfigError naming what differs);
-    it keeps the log models of ``scenarios`` (model_file.logs_of).
+    it keeps the log models of ``scenarios`` (model_file.logs_of). A sweep's own model
+    (``owned``) that no longer matches (a model of an earlier format, or of other defaults)
+    is prepared again instead; the reason is kept under "replaced".
     Returns {"path", "prepared_this_run", "counts"}: the factorizations its preparation
     cost."""
     from ..dam import model_file
     from ..errors import SavedFileError
+    replaced = None
+    if owned and (path / "manifest.json").is_file():
+        try:
+            _check_model(path, base, dt)
+        except (ConfigError, SavedFileError) as e:
+            replaced = str(e)
+            shutil.rmtree(path)
     prepared = not (path / "manifest.json").is_file()
     try:
         if prepared:
@@ -64,26 +98,37 @@ def dam_model(path: Path, base, dt: float, levels: list, face: Optional[dict] = 
                                           logs=model_file.logs_of(base, scenarios),
                                           **(face or {}))
         else:
-            manifest = model_file.read_manifest(path)
-            model_file.check_inputs(manifest, base)
-            saved_dt = manifest["inputs"]["dt_s"]
-            if float(dt) != saved_dt:
-                # The step is the sample's, not the dam's: say so, or a trial with another n
-                # looks like a broken model.
-                raise ConfigError(
-                    f"engine.model={str(path)!r}: the sweep's time step {dt:.6g} s differs "
-                    f"from the model's {saved_dt:.6g} s. The step follows from the sampled "
-                    "scenarios (the shortest log wave round trip over 40 steps, "
-                    "stage2.sweep_time_step_s), so another sample (sample.n or seed, or "
-                    "the ranges of log length, wood density or added mass) has another: "
-                    "point engine.model at a new directory to prepare a model for this one")
+            manifest = _check_model(path, base, dt)
     except SavedFileError as e:
         raise ConfigError(f"engine.model={str(path)!r}: {e}") from None
     lo, hi = manifest["inputs"]["water_levels_m"]
     if not (lo <= min(levels) and max(levels) <= hi):
         raise ConfigError(f"engine.model={str(path)!r}: its water levels {lo}..{hi} m do not "
                           f"cover the sweep's {min(levels)}..{max(levels)} m")
-    return {"path": str(path), "prepared_this_run": prepared, "counts": manifest["counts"]}
+    out = {"path": str(path), "prepared_this_run": prepared, "counts": manifest["counts"]}
+    if replaced is not None:
+        out["replaced"] = replaced
+    return out
+
+
+def _check_model(path: Path, base, dt: float) -> dict:
+    """The manifest of the model at ``path`` if it is of this dam and time step; else
+    SavedFileError or ConfigError naming what differs."""
+    from ..dam import model_file
+    manifest = model_file.read_manifest(path)
+    model_file.check_inputs(manifest, base)
+    saved_dt = manifest["inputs"]["dt_s"]
+    if float(dt) != saved_dt:
+        # The step is the sample's, not the dam's: say so, or a trial with another n looks
+        # like a broken model.
+        raise ConfigError(
+            f"engine.model={str(path)!r}: the sweep's time step {dt:.6g} s differs "
+            f"from the model's {saved_dt:.6g} s. The step follows from the sampled "
+            "scenarios (the shortest log wave round trip over 40 steps, "
+            "stage2.sweep_time_step_s), so another sample (sample.n or seed, or "
+            "the ranges of log length, wood density or added mass) has another: "
+            "point engine.model at a new directory to prepare a model for this one")
+    return manifest
 
 
 def check_all(spec: EvaluatorSpec, points: list, scenarios: list):
@@ -111,7 +156,7 @@ def run(cfg: SweepConfig, out: Optional[Union[str, Path]] = None,
     check_engine(cfg.engine)
     t0 = time.perf_counter()
     folder = Path(out or cfg.output["dir"])
-    prep = prepare(cfg)
+    prep = prepare(cfg, folder)
     prep["timings_s"] = {"prepare": time.perf_counter() - t0}
     points, scenarios = prep["points"], prep["scenarios"]
     table = ResultTable(folder, cfg.hash(), [point_hash(p) for p in points])

@@ -257,6 +257,9 @@ def _computation(s: dict) -> list:
                    if m["prepared_this_run"] else
                    f"Every worker loaded the dam model `{m['path']}`, prepared before: ")
               + "the dam's factors are restored, not factored (row `restorations`)."]
+        if "replaced" in m:
+            L += ["", f"It replaced this sweep's earlier model, which no longer matched: "
+                      f"{m['replaced']}"]
     if "counts_driver_check" in s:
         d = s["counts_driver_check"]
         L += ["", "Not in these sums: the evaluator the driving process built to check every "

@@ -39,6 +39,19 @@ class ResultTable:
         self._fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         return set(self.rows)
 
+    def check(self) -> None:
+        """Refuse (TableError) rows of another config or scenario list already in the
+        folder, as :meth:`open` would, without creating or cutting anything."""
+        if self.path.exists():
+            *complete, _ = self.path.read_bytes().split(b"\n")
+            for k, line in enumerate(complete):
+                try:
+                    row = json.loads(line)
+                except ValueError:
+                    continue  # open() names a corrupt table
+                self._accept(row, k + 1)
+            self.rows = {}
+
     def _read(self) -> None:
         data = self.path.read_bytes()
         *complete, tail = data.split(b"\n")  # tail: b"" or a line torn by a kill
