@@ -6,9 +6,12 @@ runs ``python3 -m flexcontact dam what-if MODEL ...`` ``--runs`` times, each a
 new process, on the same scenario, and records in one run: the whole command's wall time,
 the time to load the model and to answer (from the command's own --json), the counts
 (nothing of the dam factored), and the machine's load. Writes bench/dam_what_if.json
-(bench/dam_what_if_3d.json with ``--dim 3``).
+(bench/dam_what_if_3d.json with ``--dim 3``). ``--main-job`` prepares
+``examples/dam_model_main_job.toml`` instead, the 3D block at the main job's mesh with its
+crushing end, and asks the main job's own scenario (bench/dam_what_if_main_job.json), so
+that its outputs can be set beside the main job's.
 
-    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3]
+    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3 | --main-job]
 """
 import argparse
 import json
@@ -24,12 +27,18 @@ ROOT = Path(__file__).resolve().parents[1]
 ap = argparse.ArgumentParser(description=__doc__)
 ap.add_argument("--runs", type=int, default=5)
 ap.add_argument("--dim", type=int, choices=(2, 3), default=2)
+ap.add_argument("--main-job", action="store_true",
+                help="the 3D block at the main job's mesh, crushing end, main job's scenario")
 ap.add_argument("--out", default=None)
 args = ap.parse_args()
+if args.main_job:
+    args.dim = 3
 if args.out is None:
-    args.out = str(Path(__file__).with_name("dam_what_if.json" if args.dim == 2
-                                            else "dam_what_if_3d.json"))
-CONFIG = "examples/sweep_small.toml" if args.dim == 2 else "examples/sweep_3d.toml"
+    args.out = str(Path(__file__).with_name(
+        "dam_what_if_main_job.json" if args.main_job
+        else "dam_what_if.json" if args.dim == 2 else "dam_what_if_3d.json"))
+CONFIG = ("examples/dam_model_main_job.toml" if args.main_job
+          else "examples/sweep_small.toml" if args.dim == 2 else "examples/sweep_3d.toml")
 sys.path.insert(0, str(ROOT / "bench"))
 from machine import machine  # noqa: E402
 
@@ -37,6 +46,8 @@ ASK = ["--log-speed-m-s", "3", "--log-pitch-deg", "10", "--log-length-m", "12",
        "--water-level-m", "26"]
 if args.dim == 3:
     ASK += ["--log-yaw-deg", "10", "--log-across-m", "6.5"]
+if args.main_job:
+    ASK = ["--log-speed-m-s", "2"]  # DamScenario's default log, as demos/dam_debris.py
 with tempfile.TemporaryDirectory() as tmp:
     model = Path(tmp) / "model"
     t0 = time.perf_counter()
@@ -54,11 +65,18 @@ with tempfile.TemporaryDirectory() as tmp:
         out = json.loads(r.stdout)
         runs.append({"command_s": wall, **{f"{k}_s": v for k, v in out["seconds"].items()},
                      "counts": out["counts"]})
+        outputs = out["outputs"]
     size = sum(p.stat().st_size for p in model.iterdir())
 result = {
     "what": ("dam what-if from a saved model, "
-             + ("2D section" if args.dim == 2 else "3D block") + " at its default mesh"),
+             + ("3D block at the main job's mesh, crushing end" if args.main_job
+                else ("2D section" if args.dim == 2 else "3D block") + " at its default mesh")),
     "config": CONFIG, "scenario": ASK, "prepare_s": prepare_s,
+    "outputs": {k: outputs[k] for k in ("peak_force_N_per_m", "peak_force_filtered_N_per_m",
+                                        "impulse_N_s_per_m", "heel_stress_static_Pa",
+                                        "heel_stress_impact_Pa", "peak_contact_pressure_Pa",
+                                        "steps", "dam_back_substitutions",
+                                        "log_back_substitutions")},
     "model_bytes": size, "runs": runs,
     "median_s": {k: statistics.median(r[k] for r in runs)
                  for k in ("command_s", "load_s", "evaluate_s")},

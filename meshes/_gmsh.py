@@ -92,6 +92,35 @@ def mesh_uniform(dim: int, h: float) -> None:
         gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
 
 
+def mesh_with_balls(dim: int, h: float, balls=()) -> None:
+    """Mesh the current model's ``dim``-entities with elements of size ``h``, capped inside
+    each ball ``(size, x, y, z, radius, thickness)`` as in :func:`size_field`; no ball: as
+    :func:`mesh_uniform`."""
+    if not balls:
+        return mesh_uniform(dim, h)
+    field = gmsh.model.mesh.field
+    fields = []
+    for size, x, y, z, radius, thickness in balls:
+        f = field.add("Ball")
+        for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
+                         ("Thickness", thickness), ("VIn", size), ("VOut", h)):
+            field.setNumber(f, key, val)
+        fields.append(f)
+    f_min = field.add("Min")
+    field.setNumbers(f_min, "FieldsList", fields)
+    field.setAsBackgroundMesh(f_min)
+    for key in ("MeshSizeFromPoints", "MeshSizeFromCurvature", "MeshSizeExtendFromBoundary"):
+        gmsh.option.setNumber(f"Mesh.{key}", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+    try:
+        gmsh.model.mesh.generate(dim)
+    finally:  # gmsh's defaults again, for the next model of a session the caller opened
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
+        for key, default in (("MeshSizeFromPoints", 1), ("MeshSizeFromCurvature", 0),
+                             ("MeshSizeExtendFromBoundary", 1)):
+            gmsh.option.setNumber(f"Mesh.{key}", default)
+
+
 def physical(dim: int, entities, tag: int, name: str):
     """Add a named physical group of ``dim``-entities with number ``tag``."""
     gmsh.model.addPhysicalGroup(dim, list(entities), tag)

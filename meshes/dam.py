@@ -372,28 +372,35 @@ def _model_dam_only_2d(s, info, face_levels):
     return info
 
 
-def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2):
+def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2, ball=None):
     """The log in its own frame: axis along x, centre at the origin, front end (tag
     ``log_front``) at x = +L/2, shaped by ``end`` (a :class:`~.log_end.LogEnd`; None: flat);
-    elements of size ``h_m``. In 2D a plane-strain slab ``length_m`` × ``diameter_m``
-    (facets ``log_front``, ``log_back``, ``log_upper``, ``log_lower``), in 3D a round log
-    (faces ``log_front``, ``log_back``, ``log_mantle``). Cells ``log``. Returns (mesh,
-    cell_tags, facet_tags, info)."""
+    elements of size ``h_m``, and of ``size`` within ``zone`` of the point (a, b) (3D:
+    (a, b, 0)) when ``ball`` = (a, b, size, zone) is given: the crushed patch's refinement
+    (blending to ``h_m`` over 2(h_m − size), as the whole mesh's contact ball). In 2D a
+    plane-strain slab ``length_m`` × ``diameter_m`` (facets ``log_front``, ``log_back``,
+    ``log_upper``, ``log_lower``), in 3D a round log (faces ``log_front``, ``log_back``,
+    ``log_mantle``). Cells ``log``. Returns (mesh, cell_tags, facet_tags, info)."""
     from ._check import positive
     L, D, h = (positive(n, v) for n, v in (("length_m", length_m), ("diameter_m", diameter_m),
                                            ("h_m", h_m)))
     end = (LogEnd() if end is None else end).check(D, ("end.shape", "end.chamfer_m",
                                                        "end.radius_m"))
+    balls = ()
+    if ball is not None:
+        a, b, size, zone = (float(v) for v in ball)
+        balls = ((size, a, b, 0.0, zone, 2.0 * (h - size)),)
     if dim == 3:
         from .dam_apart_3d import build_log_3d
-        return build_log_3d(comm, L, D, h, end)
+        return build_log_3d(comm, L, D, h, end, balls)
     if dim != 2:
         raise InputError(f"dim={dim!r}: the log is meshed in 2D or 3D")
     info = dict(dim=2, length_m=L, diameter_m=D, h_m=h, end_shape=end.shape)
-    return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, end, info), gdim=2)
+    return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, end, info, balls),
+                          gdim=2)
 
 
-def _model_log_2d(L, D, h, end, info):
+def _model_log_2d(L, D, h, end, info, balls=()):
     import gmsh
     geo = gmsh.model.geo
     curves, surface = log_outline_2d(geo, L, 0.5 * D, end, lambda x, y: (x, y))
@@ -401,5 +408,5 @@ def _model_log_2d(L, D, h, end, info):
     _gmsh.physical(2, [surface], LOG, NAMES[LOG])
     for tag in (LOG_LOWER, LOG_FRONT, LOG_UPPER, LOG_BACK):
         _gmsh.physical(1, curves[tag], tag, NAMES[tag])
-    _gmsh.mesh_uniform(2, h)
+    _gmsh.mesh_with_balls(2, h, balls)
     return info

@@ -78,14 +78,15 @@ def _model(s, info, face_levels, strip, patch_y):
     return info
 
 
-def build_log_3d(comm, L: float, D: float, h: float, end):
+def build_log_3d(comm, L: float, D: float, h: float, end, balls=()):
     """The round log (length ``L``, diameter ``D``, front end ``end``, checked) in its own
-    frame, elements of size ``h``."""
+    frame, elements of size ``h`` (capped in ``balls``, _gmsh.mesh_with_balls)."""
     info = dict(dim=3, length_m=L, diameter_m=D, h_m=h, end_shape=end.shape)
-    return _gmsh.generate(comm, "log3d", lambda: _model_log(L, D, h, end, info), gdim=3)
+    return _gmsh.generate(comm, "log3d", lambda: _model_log(L, D, h, end, info, balls),
+                          gdim=3)
 
 
-def _model_log(L, D, h, end, info):
+def _model_log(L, D, h, end, info, balls=()):
     import gmsh
     occ = gmsh.model.occ
     centre, axis = np.zeros(3), np.array([1.0, 0.0, 0.0])
@@ -94,6 +95,6 @@ def _model_log(L, D, h, end, info):
     _gmsh.physical(3, [vol], LOG, NAMES[LOG])
     for tag, fs in log_faces_3d(vol, centre, axis, L, 0.5 * D, end).items():
         _gmsh.physical(2, fs, tag, NAMES[tag])
-    _gmsh.mesh_uniform(3, h)
+    _gmsh.mesh_with_balls(3, h, balls)
     return info
 

@@ -6,6 +6,7 @@ nodal-average contact pressure above σ_c), the conservation of momentum, the en
 the elastic run as an upper bound, and the monolithic run for the evaluator (the meshes of
 the two differ, as in tests/test_dam_reuse.py: impulse within 1 %).
 """
+import dolfinx
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -113,3 +114,96 @@ def test_bad_crushing_inputs_are_named_before_meshing(change, words):
     from flexcontact.errors import InputError
     with pytest.raises(InputError, match=words):
         DamScenario(**change)
+
+
+# ---- the crushed patch's refinement on the factored dam's log -----------------------------
+
+@pytest.mark.parametrize("dim, end, angles", [
+    (3, {}, [(10.0, 0.0), (0.0, 10.0), (15.0, -10.0), (5.0, 12.0)]),
+    (3, {"log_end_shape": "chamfered", "log_end_chamfer_m": 0.05}, [(10.0, 0.0), (3.0, 8.0)]),
+    (2, {}, [(10.0, 0.0), (4.0, 0.0)]),
+])
+def test_one_log_mesh_refined_at_its_rim_serves_every_pitch_and_yaw(dim, end, angles):
+    """The factored dam's log is meshed once in its own frame with the contact ball at the
+    first-contact point (log_model.contact_ball): on a flat or bevelled end that point is on
+    the rim whatever the pitch and yaw, so every angle gets the same ball, and the placement
+    (the pitch and yaw after a turn about the log's axis) carries the ball's centre onto the
+    scenario's first-contact point (1e-12 m)."""
+    from flexcontact.dam.log_model import contact_ball, placement
+    balls = set()
+    for pitch, yaw in angles:
+        s = DamScenario(dim=dim, log_pitch_deg=pitch, log_yaw_deg=yaw,
+                        mesh_size_contact_m=0.0125, contact_zone_m=0.35, **end)
+        ball = contact_ball(s)
+        balls.add(ball)
+        local = np.array([ball[0], ball[1], 0.0][:dim])
+        x = s.log_centre + placement(s, ball) @ local
+        assert np.allclose(x, s.log_front_point, rtol=0, atol=1e-12), (pitch, yaw)
+    assert len(balls) == 1
+    assert contact_ball(DamScenario(dim=dim, **end)) is None  # no ball asked: none made
+
+
+def test_a_rounded_end_gets_a_log_per_point_of_its_cap():
+    """On a rounded end the first-contact point moves along the cap with the angle: two
+    pitches, two balls, each placed onto its own point (to the micrometre to which the
+    ball's point is rounded)."""
+    from flexcontact.dam.log_model import contact_ball, placement
+    points = []
+    for pitch in (5.0, 12.0):
+        s = DamScenario(dim=3, log_pitch_deg=pitch, log_end_shape="rounded",
+                        log_end_radius_m=0.8, mesh_size_contact_m=0.0125, contact_zone_m=0.35)
+        ball = contact_ball(s)
+        x = s.log_centre + placement(s, ball) @ np.array([ball[0], ball[1], 0.0])
+        assert np.allclose(x, s.log_front_point, rtol=0, atol=1e-6)
+        points.append(ball)
+    assert points[0] != points[1]
+
+
+@pytest.fixture(scope="module")
+def refined_patch_runs():
+    """The factored dam and the monolithic run at the main job's 2D mesh with its crushed
+    patch (6.25 mm within 0.1 m of the first contact)."""
+    from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
+    from flexcontact.sweep.monolithic import MonolithicEvaluator
+    far, impact = MAIN_JOB_MESH[2]
+    h_c, zone = CRUSHED_PATCH_MESH[2]
+    s = DamScenario(mesh_size_far_m=far, mesh_size_impact_m=impact, mesh_size_contact_m=h_c,
+                    contact_zone_m=zone, log_end_crushes=True)
+    ev = ScenarioEvaluator(s, comm=COMM)
+    f = ev.evaluate(s)
+    assert ev.log_model(s).mesh.ball is not None
+    m = MonolithicEvaluator(s, dt_s=sweep_time_step_s([s]), water_levels_m=[s.water_level_m],
+                            comm=COMM).evaluate(s)
+    return s, f, m
+
+
+def test_factored_dam_with_the_crushed_patch_refined_agrees_with_the_monolithic_run(
+        refined_patch_runs):
+    """The factored-dam evaluator refines its own log where the scenario asks and agrees
+    with the monolithic run: filtered peak force within 2 %, Δσ_heel within 5 % (measured
+    +0.9 % and +0.9 % with DOLFINx 0.5, +1.4 % and +0.04 % with 0.9, −1.6 % and +3.6 % with
+    0.11). Its log used to ignore the refinement: a filtered peak of 2.61 MN/m against
+    1.43, and heel tension where the monolithic run has none."""
+    s, f, m = refined_patch_runs
+    assert f["peak_force_filtered_N_per_m"] == pytest.approx(m["peak_force_filtered_N_per_m"],
+                                                             rel=0.02)
+    d_f = f["heel_stress_impact_Pa"] - f["heel_stress_static_Pa"]
+    d_m = m["heel_stress_impact_Pa"] - m["heel_stress_static_Pa"]
+    assert d_f == pytest.approx(d_m, rel=0.05)
+    assert f["peak_contact_pressure_Pa"] <= s.wood_crushing_strength_Pa * (1 + 1e-8)
+
+
+_DOLFINX_0_10_OR_LATER = tuple(int(v) for v in dolfinx.__version__.split(".")[:2]) >= (0, 10)
+
+
+@pytest.mark.xfail(_DOLFINX_0_10_OR_LATER, strict=True, reason=(
+    "with DOLFINx 0.11's stack the monolithic run's impulse at this crushing mesh is "
+    "12,356 N·s/m against 12,700-12,747 with 0.5 and 0.9, while the factored dam's stays "
+    "12,702-12,763: +2.8 %, beyond 1 %. Which nodes crush at which step turns on signs of "
+    "quantities near zero (docs/dam.md, the mesh study)"))
+def test_factored_dam_with_the_crushed_patch_refined_conserves_the_monolithic_impulse(
+        refined_patch_runs):
+    """Impulse within 1 % of the monolithic run (measured +0.47 % with DOLFINx 0.5, +0.13 %
+    with 0.9)."""
+    _, f, m = refined_patch_runs
+    assert f["impulse_N_s_per_m"] == pytest.approx(m["impulse_N_s_per_m"], rel=0.01)

@@ -32,7 +32,6 @@ from ..postprocess import impact_step_forces, peak_pressure_Pa
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .key_numbers import halfspace_tension_Pa
-from .log_model import rotation
 from .stage2 import (MARGIN, approach_time_s, force_filter_window_s, log_crushing_strength_Pa,
                      response_duration_s)
 
@@ -118,7 +117,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     if after_contact not in AFTER_CONTACT:
         raise ValueError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
     h, theta, d = dam.dt, dam.theta, s.dim
-    R = rotation(s.log_pitch_deg, s.log_yaw_deg, d)
+    R = log.placement(s)
     slave = log.placed_front(R, s.log_centre)
     pairs = build_surface_pairs([("node_to_surface", slave, dam.face)], d)
     m = pairs.m

@@ -6,7 +6,9 @@ where K is not) is factored once and condensed on the front end's nodes. A scena
 the same log but another pitch, water level, speed or friction only places it: a rigid
 rotation R (the pitch) and a translation. Positions and velocities rotate by R per node,
 the flexibility blockwise, W_global = R W_local Rᵀ (Ŵ is isotropic: rotating the body
-rotates its operators).
+rotates its operators). A log refined at its first-contact point (a crushing end's patch)
+is meshed with that refinement in its own frame; a round log is first turned about its
+own axis onto the point (:func:`contact_ball`, :func:`placement`).
 
 During an impact the log's displacement is split as u = V₀ t + w with V₀ its rigid approach
 velocity: K V₀ = 0, so w and its velocity ω obey the homogeneous equations driven by the
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Optional
 
 import numpy as np
 import ufl
@@ -49,6 +52,42 @@ def rotation(pitch_deg: float, yaw_deg: float = 0.0, dim: int = 2) -> np.ndarray
     return yaw @ pitch
 
 
+def contact_ball(s) -> Optional[tuple]:
+    """Where scenario ``s`` refines its log's end (``mesh_size_contact_m`` below
+    h_impact), in the log's own frame: (a, b, size, zone), the ball of radius
+    ``contact_zone_m`` at (a, b) (3D: (a, b, 0)) with elements of ``h_contact_m``; None
+    without. (a, b) is the first-contact point: its axial and lateral (2D) or radial (3D)
+    coordinates, to the micrometre so that every pitch and yaw with the same point shares
+    one log. A round log is the same log turned about its axis, so in 3D the ball sits at
+    azimuth 0 and :func:`placement` turns the log to the point's azimuth: a flat or
+    chamfered end's first contact is on its rim whatever the pitch and yaw, so one log
+    serves them all; a rounded end's moves along the cap with the angle."""
+    if s.mesh_size_contact_m is None or s.h_contact_m >= s.h_impact_m:
+        return None
+    q = _first_contact_local(s)
+    b = q[1] if s.dim == 2 else math.hypot(q[1], q[2])
+    return (round(float(q[0]), 6), round(float(b), 6), float(s.h_contact_m),
+            float(s.contact_zone_m))
+
+
+def _first_contact_local(s) -> np.ndarray:
+    R = rotation(s.log_pitch_deg, s.log_yaw_deg, s.dim)
+    return R.T @ (np.asarray(s.log_front_point, float) - np.asarray(s.log_centre, float))
+
+
+def placement(s, ball=None) -> np.ndarray:
+    """The rotation placing the log of scenario ``s`` from its own frame: :func:`rotation`
+    of its pitch and yaw, after, for a 3D log meshed with its contact ball (``ball``), the
+    turn about its axis that takes the ball's azimuth (0) to the first-contact point's."""
+    R = rotation(s.log_pitch_deg, s.log_yaw_deg, s.dim)
+    if ball is None or s.dim == 2:
+        return R
+    q = _first_contact_local(s)
+    phi = math.atan2(q[2], q[1]) if math.hypot(q[1], q[2]) > 1e-12 else 0.0
+    c, si = math.cos(phi), math.sin(phi)
+    return R @ np.array([[1.0, 0.0, 0.0], [0.0, c, -si], [0.0, si, c]])
+
+
 def rotate_blocks(W: np.ndarray, R: np.ndarray) -> np.ndarray:
     """R W Rᵀ blockwise: every d×d node block W_ij → R W_ij Rᵀ (W node-major)."""
     d = R.shape[0]
@@ -64,14 +103,16 @@ class LogMesh:
     2 (a plane-strain slab) or 3 (a round log). Serial."""
 
     def __init__(self, length_m: float, diameter_m: float, E: float, nu: float,
-                 h_m: float = None, comm=MPI.COMM_SELF, end=None, dim: int = 2):
+                 h_m: float = None, comm=MPI.COMM_SELF, end=None, dim: int = 2,
+                 ball: Optional[tuple] = None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         self.length_m, self.diameter_m = float(length_m), float(diameter_m)
         h = h_m if h_m is not None else diameter_m / 4
         self.dim = int(dim)
+        self.ball = None if ball is None else tuple(float(v) for v in ball)
         self.msh, self.cell_tags, self.facet_tags, _ = dam_mesh.build_log(
-            comm, length_m, diameter_m, h, end, dim=self.dim)
+            comm, length_m, diameter_m, h, end, dim=self.dim, ball=self.ball)
         self.V = compat.vector_space(self.msh)
         mat = Material(E_Pa=E, nu=nu, rho_kg_m3=1.0, name="wood")
         u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
@@ -95,6 +136,8 @@ class LogMesh:
         the front end's surface), as arrays named ``prefix`` + name."""
         out = {f"{prefix}x_nodes": self.x_nodes, f"{prefix}dims": np.array(
             [self.dim, self.length_m, self.diameter_m])}
+        if self.ball is not None:
+            out[f"{prefix}ball"] = np.array(self.ball)
         for name, A in (("K", self.K), ("M1", self.M1)):
             ai, aj, av = A.getValuesCSR()
             out.update({f"{prefix}{name}_indptr": ai, f"{prefix}{name}_indices": aj,
@@ -109,6 +152,8 @@ class LogMesh:
         self = cls.__new__(cls)
         dim, self.length_m, self.diameter_m = arrays[f"{prefix}dims"]
         self.dim = int(dim)
+        ball = arrays.get(f"{prefix}ball")
+        self.ball = None if ball is None else tuple(float(v) for v in np.asarray(ball))
         self.msh = self.cell_tags = self.facet_tags = self.V = None
         self.x_nodes = np.asarray(arrays[f"{prefix}x_nodes"])
         n = self.x_nodes.shape[0] * self.dim
@@ -211,6 +256,10 @@ class LogModel:
             x = PETSc.Vec().createSeq(n, comm=PETSc.COMM_SELF)
         x.zeroEntries()
         return x
+
+    def placement(self, s) -> np.ndarray:
+        """The rotation placing this log for scenario ``s`` (log_model.placement)."""
+        return placement(s, self.mesh.ball)
 
     def placed_front(self, R: np.ndarray, centre: np.ndarray) -> dict:
         """The front end's surface dict (surface_nodes layout) placed in the dam's frame."""

@@ -27,7 +27,7 @@ from mpi4py import MPI
 from .. import impact_setup as setup
 from .coupled_step import AFTER_CONTACT, expected_contact_s, run_impact
 from .dam_model import DamModel, front_end_span_m
-from .log_model import LogMesh, LogModel
+from .log_model import LogMesh, LogModel, contact_ball
 from .scenario import DamScenario
 from .stage2 import sweep_time_step_s
 from ..errors import InputError
@@ -52,10 +52,16 @@ def check_same_dam(base: DamScenario, scenario: DamScenario) -> None:
 
 
 def log_key(s: DamScenario) -> tuple:
-    """What a LogModel depends on: length, diameter, density, added-mass coefficient, E, ν
-    and the front end's shape."""
+    """What a LogModel depends on: length, diameter, density, added-mass coefficient, E, ν,
+    the front end's shape and, when the scenario refines the crushed patch, where
+    (log_model.contact_ball)."""
     return (s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3, s.added_mass_coefficient,
-            s.wood.E_Pa, s.wood.nu, s.log_end)
+            s.wood.E_Pa, s.wood.nu, s.log_end) + _ball_key(s)
+
+
+def _ball_key(s: DamScenario) -> tuple:
+    ball = contact_ball(s)
+    return () if ball is None else (ball,)
 
 
 class LogCache:
@@ -71,7 +77,8 @@ class LogCache:
 
     @staticmethod
     def _mesh_key(s: DamScenario) -> tuple:
-        return (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu, s.log_end)
+        return (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu,
+                s.log_end) + _ball_key(s)
 
     def get(self, s: DamScenario) -> LogModel:
         key = log_key(s)
@@ -80,14 +87,19 @@ class LogCache:
             if mesh_key not in self.meshes:
                 t0 = time.perf_counter()
                 self.meshes[mesh_key] = LogMesh(*mesh_key[:4], h_m=self.h_m, comm=self.comm,
-                                                end=s.log_end, dim=s.dim)
+                                                end=s.log_end, dim=s.dim,
+                                                ball=contact_ball(s))
                 self.mesh_s += time.perf_counter() - t0
             self.models[key] = self._model(s, self.meshes[mesh_key])
         return self.models[key]
 
     def restore(self, s: DamScenario, mesh, factor) -> None:
         """Adopt the log of scenario ``s`` from a model file: its LogMesh without a mesh and
-        its dense factor (counted as a restoration, not a factorization)."""
+        its dense factor (counted as a restoration, not a factorization). A log saved
+        without the contact ball its scenario now asks for is not adopted: it is built when
+        asked."""
+        if mesh.ball != contact_ball(s):
+            return
         self.meshes.setdefault(self._mesh_key(s), mesh)
         self.models[log_key(s)] = self._model(s, mesh, factor)
 
