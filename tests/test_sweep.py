@@ -499,6 +499,16 @@ def test_default_model_is_the_sweeps_own_prepared_once_and_replaced_if_stale(tmp
                                                          "report.md").read_text()
     m = json.loads((tmp_path / "longer" / "dam_model" / "manifest.json").read_text())
     assert m["inputs"]["dt_s"] == pytest.approx(s["dt_s"], rel=0)
+    # A worker that does not see the sweep's folder (a Dask worker elsewhere) factors the
+    # dam itself rather than fail; one given a model path of its own still needs it.
+    from dataclasses import replace
+    from flexcontact.sweep.driver import prepare
+    spec = prepare(sweep.from_dict(raw), out)["spec"]
+    assert spec.loads_model() and spec.model == str((out / "dam_model").resolve())
+    elsewhere = replace(spec, model=str(tmp_path / "not_here" / "dam_model"))
+    assert not elsewhere.loads_model()
+    assert elsewhere.build().counts()["factorizations"]["dam_stage1"] == 1
+    assert replace(elsewhere, model_if_seen=False).loads_model()
     # --no-model: the (serial) evaluator factors K, K_eff and the log itself.
     cfg = write_toml(tmp_path / "own.toml", raw)
     proc = subprocess.run([sys.executable, "-m", "flexcontact", "sweep", str(cfg), "--out",

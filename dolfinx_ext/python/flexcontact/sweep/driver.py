@@ -51,7 +51,7 @@ def prepare(cfg: SweepConfig, folder: Optional[Path] = None) -> dict:
             # for a sweep that will not run.
             ResultTable(folder, cfg.hash(), [point_hash(p) for p in points]).check()
         prep["model"] = dam_model(model, base, dt, levels, face, scenarios, owned=owned)
-        spec = prep["spec"] = replace(spec, model=str(model.resolve()))
+        spec = prep["spec"] = replace(spec, model=str(model.resolve()), model_if_seen=owned)
     if hasattr(cls, "check"):
         prep["checker"] = check_all(spec, points, scenarios)
     return prep

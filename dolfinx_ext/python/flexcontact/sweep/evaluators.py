@@ -76,10 +76,21 @@ class EvaluatorSpec:
     face: Optional[dict] = None
     """The "reuse" evaluator's face region, {"strip_m", "patch_y_m"}, holding every
     scenario of the sweep (dam_model.face_region_m)."""
+    model_if_seen: bool = False
+    """``model`` is the sweep's own, in its output folder: a worker that does not see that
+    folder (a Dask worker on another machine without a shared file system) factors the dam
+    itself, and its counts say so."""
+
+    def loads_model(self) -> bool:
+        """Whether :meth:`build` loads the dam model (here, in this process)."""
+        from pathlib import Path
+        if self.model is None:
+            return False
+        return not self.model_if_seen or (Path(self.model) / "manifest.json").is_file()
 
     def build(self):
         from mpi4py import MPI
-        if self.model is not None:
+        if self.loads_model():
             from ..dam import model_file
             model_file.check_inputs(model_file.read_manifest(self.model), self.base,
                                     self.dt_s)
