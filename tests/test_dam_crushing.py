@@ -6,11 +6,11 @@ nodal-average contact pressure above σ_c), the conservation of momentum, the en
 the elastic run as an upper bound, and the monolithic run for the evaluator (the meshes of
 the two differ, as in tests/test_dam_reuse.py: impulse within 1 %).
 """
-import dolfinx
 import numpy as np
 import pytest
 from mpi4py import MPI
 
+from flexcontact import compat
 from flexcontact.dam import DamScenario
 from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
 from flexcontact.dam.stage1 import solve_stage1
@@ -86,7 +86,6 @@ def test_crushing_strength_is_a_sweep_input(tmp_path):
 def test_the_contact_ball_refines_the_first_contact_point():
     """mesh_size_contact_m: elements of about that size within contact_zone_m of the first
     contact point (2D), the rest of the mesh as without it."""
-    from flexcontact import compat
     from flexcontact.meshes import dam as dam_mesh
     coarse = DamScenario()
     fine = coarse.replace(mesh_size_contact_m=0.0125, contact_zone_m=0.1)
@@ -193,7 +192,7 @@ def test_factored_dam_with_the_crushed_patch_refined_agrees_with_the_monolithic_
     assert f["peak_contact_pressure_Pa"] <= s.wood_crushing_strength_Pa * (1 + 1e-8)
 
 
-_DOLFINX_0_10_OR_LATER = tuple(int(v) for v in dolfinx.__version__.split(".")[:2]) >= (0, 10)
+_DOLFINX_0_10_OR_LATER = compat.VERSION >= (0, 10)
 
 
 @pytest.mark.xfail(_DOLFINX_0_10_OR_LATER, strict=True, reason=(
