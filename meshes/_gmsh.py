@@ -98,19 +98,7 @@ def mesh_with_balls(dim: int, h: float, balls=()) -> None:
     :func:`mesh_uniform`."""
     if not balls:
         return mesh_uniform(dim, h)
-    field = gmsh.model.mesh.field
-    fields = []
-    for size, x, y, z, radius, thickness in balls:
-        f = field.add("Ball")
-        for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
-                         ("Thickness", thickness), ("VIn", size), ("VOut", h)):
-            field.setNumber(f, key, val)
-        fields.append(f)
-    f_min = field.add("Min")
-    field.setNumbers(f_min, "FieldsList", fields)
-    field.setAsBackgroundMesh(f_min)
-    for key in ("MeshSizeFromPoints", "MeshSizeFromCurvature", "MeshSizeExtendFromBoundary"):
-        gmsh.option.setNumber(f"Mesh.{key}", 0)
+    _background([_ball(*b, h) for b in balls])
     gmsh.option.setNumber("Mesh.MeshSizeMax", h)
     try:
         gmsh.model.mesh.generate(dim)
@@ -156,22 +144,35 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
         field.setNumber(f_box, "VIn", size)
         field.setNumber(f_box, "VOut", h_far)
         fields.append(f_box)
-    for size, x, y, z, radius, thickness in balls:
-        f_ball = field.add("Ball")
-        for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
-                         ("Thickness", thickness), ("VIn", size), ("VOut", h_far)):
-            field.setNumber(f_ball, key, val)
+    for ball in balls:
+        f_ball = _ball(*ball, h_far)
         if balls_only_in:
             f_ball = _restricted(f_ball, balls_only_in)
         fields.append(f_ball)
+    _background(fields)
+
+
+def _ball(size, x, y, z, radius, thickness, v_out) -> int:
+    """A Ball field: ``size`` inside the ball, blending to ``v_out`` over ``thickness``."""
+    field = gmsh.model.mesh.field
+    f = field.add("Ball")
+    for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
+                     ("Thickness", thickness), ("VIn", size), ("VOut", v_out)):
+        field.setNumber(f, key, val)
+    return f
+
+
+def _background(fields: list) -> None:
+    """The smallest of ``fields`` as the background size, and no size from points,
+    curvature or the boundary."""
+    field = gmsh.model.mesh.field
     if len(fields) > 1:
         f_min = field.add("Min")
         field.setNumbers(f_min, "FieldsList", fields)
         fields = [f_min]
     field.setAsBackgroundMesh(fields[0])
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    for key in ("MeshSizeFromPoints", "MeshSizeFromCurvature", "MeshSizeExtendFromBoundary"):
+        gmsh.option.setNumber(f"Mesh.{key}", 0)
 
 
 def _restricted(f_in: int, volumes) -> int:

@@ -88,8 +88,14 @@ def _contact_ball(s) -> tuple:
     centre = front.copy()
     centre[0] = 0.5 * front[0]
     x, y, z = (centre[0], centre[1], 0.0) if s.dim == 2 else tuple(centre)
-    return ((s.h_contact_m, float(x), float(y), float(z), s.contact_zone_m,
-             2.0 * (s.h_impact_m - s.h_contact_m)),)
+    return (ball_cap(s.h_contact_m, (x, y, z), s.contact_zone_m, s.h_impact_m),)
+
+
+def ball_cap(size, centre, radius, h) -> tuple:
+    """A ball cap of _gmsh.size_field: ``size`` within ``radius`` of ``centre`` (x, y, z),
+    blending to the surrounding ``h`` over 2(h − size), a growth rate of 1/2."""
+    x, y, z = (float(v) for v in centre)
+    return (size, x, y, z, radius, 2.0 * (h - size))
 
 
 def _model_2d(s, info):
@@ -389,7 +395,7 @@ def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2, ball=None):
     balls = ()
     if ball is not None:
         a, b, size, zone = (float(v) for v in ball)
-        balls = ((size, a, b, 0.0, zone, 2.0 * (h - size)),)
+        balls = (ball_cap(size, (a, b, 0.0), zone, h),)
     if dim == 3:
         from .dam_apart_3d import build_log_3d
         return build_log_3d(comm, L, D, h, end, balls)

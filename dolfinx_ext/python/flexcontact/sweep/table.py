@@ -44,29 +44,29 @@ class ResultTable:
         folder, as :meth:`open` would, without creating or cutting anything."""
         if self.path.exists():
             *complete, _ = self.path.read_bytes().split(b"\n")
-            for k, line in enumerate(complete):
-                try:
-                    row = json.loads(line)
-                except ValueError:
-                    continue  # open() names a corrupt table
-                self._accept(row, k + 1)
+            self._accept_lines(complete, strict=False)  # open() names a corrupt table
             self.rows = {}
 
     def _read(self) -> None:
         data = self.path.read_bytes()
         *complete, tail = data.split(b"\n")  # tail: b"" or a line torn by a kill
-        for k, line in enumerate(complete):
-            try:
-                row = json.loads(line)
-            except ValueError:
-                raise TableError(f"{self.path}: line {k + 1} is not a JSON row; the table "
-                                 f"is corrupt (not a torn last line)") from None
-            self._accept(row, k + 1)
+        self._accept_lines(complete, strict=True)
         if tail:
             with open(self.path, "r+b") as f:
                 f.truncate(len(data) - len(tail))
                 f.flush()
                 os.fsync(f.fileno())
+
+    def _accept_lines(self, lines: list, strict: bool) -> None:
+        for k, line in enumerate(lines):
+            try:
+                row = json.loads(line)
+            except ValueError:
+                if not strict:
+                    continue
+                raise TableError(f"{self.path}: line {k + 1} is not a JSON row; the table "
+                                 f"is corrupt (not a torn last line)") from None
+            self._accept(row, k + 1)
 
     def _accept(self, row: dict, line: int) -> None:
         where = f"{self.path}, line {line}"
