@@ -16,7 +16,8 @@ from flexcontact.dam.log_model import rotate_blocks, rotation
 from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
 from flexcontact.dam.statics import hand_statics
 from flexcontact.dam.stage1 import solve_stage1
-from flexcontact.dam.stage2 import response_duration_s, solve_stage2
+from flexcontact.dam.stage2 import (log_crushing_strength_Pa, response_duration_s,
+                                     solve_stage2)
 
 COMM = MPI.COMM_SELF
 BASE = DamScenario(mesh_size_far_m=6.0, mesh_size_impact_m=0.4)
@@ -197,7 +198,11 @@ def test_each_rank_evaluates_alone_with_the_serial_answer(both, tmp_path):
 # ---- the base section after the contact, from response functions (dam/response.py) -----
 
 SCENARIOS = [BASE, BASE.replace(log_pitch_deg=0.0, log_speed_m_s=3.0),
-             BASE.replace(log_pitch_deg=15.0, friction_mu=0.3, water_level_m=LEVELS[0])]
+             BASE.replace(log_pitch_deg=15.0, friction_mu=0.3, water_level_m=LEVELS[0]),
+             # A crushed end re-contacts from its crushed surface, behind its nodes: the
+             # dam must still stop being stepped once the log has left.
+             BASE.replace(log_speed_m_s=3.0, log_end_crushes=True,
+                          wood_crushing_strength_Pa=15e6)]
 
 
 def _pair(evaluator, s, **kw):
@@ -229,9 +234,15 @@ def test_convolved_section_equals_the_stepped_one(evaluator, k):
     for key in ("peak_force_N_per_m", "impulse_N_s_per_m", "contact_duration_s",
                 "peak_tensile_stress_Pa", "peak_contact_pressure_Pa"):
         assert convolved[key] == stepped[key], key
-    assert convolved["dam_steps_convolved"] > 0.5 * convolved["steps"]
+    # The crushed run's contact lasts longer (10.0 ms against 6.0): measured 153 of 369
+    # steps convolved, and 40 if the crushed end were taken where its nodes are.
+    share = 0.4 if SCENARIOS[k].log_end_crushes else 0.5
+    assert convolved["dam_steps_convolved"] > share * convolved["steps"]
     assert (convolved["dam_back_substitutions"] + convolved["dam_steps_convolved"]
             == stepped["dam_back_substitutions"])
+    if SCENARIOS[k].log_end_crushes:   # it did crush: the pressure reached σ_c
+        assert stepped["peak_contact_pressure_Pa"] == pytest.approx(
+            log_crushing_strength_Pa(SCENARIOS[k]), rel=1e-12)
     # The impulse the dam felt is the log's momentum change, as stepped.
     assert abs(stepped["face_impulses"][:, 0::2].sum() - stepped["impulse_N_s_per_m"]) \
         <= 1e-9 * stepped["impulse_N_s_per_m"]

@@ -159,7 +159,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
         u_log = _log_values(log, bl.w, R, V0 * t)
         if stopped is not None:
             if _cannot_touch(pairs.x[:m], u_log, _log_values(log, bl.omega, R, V0), face_x,
-                             stopped["bound"], h):
+                             stopped["bound"], h, _crush_recess(kernel, pairs)):
                 bl.advance(_free_log_step(log, bl), h, theta)
                 records.append(SimpleNamespace(t_s=(i + 1) * h, active=0, normal_force=0.0))
                 clock["log_only_steps_s"] += time.perf_counter() - t_step
@@ -235,12 +235,25 @@ def _section_outputs(static, section: dict) -> dict:
             "base_moment_change_Nm_per_m": float(np.abs(section["moment_centre_Nm"]).max())}
 
 
-def _cannot_touch(x_log, u_log, v_log, face_x, bound, h: float) -> bool:
+def _crush_recess(kernel, pairs) -> Optional[np.ndarray]:
+    """Per front node, the x by which its crushed surface lies behind the node (≤ 0 as the
+    face's normal points at the log): δ n_x, or None if the interface cannot crush."""
+    if pairs.crushing_strength is None:
+        return None
+    delta = np.asarray(kernel.node_crush_depth)[:pairs.m]
+    return delta * np.asarray(pairs.normal)[:, 0]
+
+
+def _cannot_touch(x_log, u_log, v_log, face_x, bound, h: float,
+                  recess: Optional[np.ndarray] = None) -> bool:
     """Whether the log's front cannot reach the face within the next step: its nodes
     (reference ``x_log`` + ``u_log``, moving at ``v_log``) stay behind every face node's
-    static x less its energy ``bound``, by two steps of their own motion."""
+    static x less its energy ``bound``, by two steps of their own motion. A crushed node
+    re-contacts from its crushed surface (docs/crushing.md), ``recess`` (δ n_x) behind it:
+    without it, the crushed end would seem to reach into the face for ever."""
     d = x_log.shape[1]
-    front = (x_log[:, 0] + u_log[0::d]).max()
+    x = x_log[:, 0] + u_log[0::d]
+    front = (x if recess is None else x + recess).max()
     reach = 2.0 * h * np.abs(v_log[0::d]).max()
     return bool(front + reach < (face_x - bound).min())
 
