@@ -107,7 +107,7 @@ for _ in range(args.rounds):
         timings = {}
         out = coupled.run_impact(ev.dam, log, scenario, static, ev.offset_m, ev.after_contact,
                                  timings=timings)
-        runs[name].append({**{k: v for k, v in timings.items()},
+        runs[name].append({**timings,
                            **{f"{k}_s": v for k, v in seconds.items()},
                            **{f"{k}_calls": v for k, v in calls.items()},
                            "dam_back_substitutions": out["dam_back_substitutions"],
