@@ -38,12 +38,11 @@ def both(evaluator):
     return out, r1, r2
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "the recovered peak principal stress 1 m from the contact differs by +6.2 % between the "
-    "two triangulations: 0.4 m elements there (r/h = 2.5), where the reading's error on "
-    "Flamant's exact solution is up to 10 % (tests/test_stress_probe.py)"))
 def test_same_peak_principal_stress_as_the_monolithic_run(both):
-    """Within 6 %, as the cell-wise reading was (measured −3.9 % then)."""
+    """Within 6 %, as the cell-wise reading was (measured −3.9 % then). The recovered
+    reading 1 m from the contact, on 0.4 m elements (r/h = 2.5, where its error on
+    Flamant's exact solution is up to 10 %, tests/test_stress_probe.py): measured +3.2 %
+    with the scenario's θ = 0.55, +6.2 % with θ = ½."""
     out, _, r2 = both
     assert abs(out["peak_tensile_stress_Pa"] / r2.peak_tensile_stress_Pa - 1) <= 0.06
 
@@ -273,7 +272,8 @@ def test_a_log_coming_back_steps_the_dam_again(evaluator, monkeypatch):
 
 def test_the_energy_bound_holds_on_the_stepped_dam(evaluator):
     """|w_i| ≤ sqrt(2E (K⁻¹)_ii) at every face node after the contact, E the dam's energy
-    when the log left (constant for θ = 1/2): checked along the stepped run."""
+    when the log left, which never grows without impulse (it loses (θ − ½)(‖Δv‖²_M +
+    ‖Δu‖²_K) a step; constant for θ = ½): checked along the stepped run."""
     from flexcontact.dam import coupled_step
     dam, s = evaluator.dam, SCENARIOS[1]
     log, static = evaluator.log_model(s), dam.static_state(s.water_level_m)
@@ -293,9 +293,12 @@ def test_the_energy_bound_holds_on_the_stepped_dam(evaluator):
     first = len(seen) - (out["steps"] - end)
     E = seen[first][0]
     c = dam.face_compliance(0)
+    previous = E
     for e, w in seen[first:]:
-        assert abs(e - E) <= 1e-9 * E
+        assert e <= previous * (1 + 1e-12)
+        previous = e
         assert (np.abs(w) <= np.sqrt(2 * E * c) * (1 + 1e-12)).all()
+    assert s.time_scheme_theta > 0.5 and previous < E   # the scheme's damping is at work
 
 
 def test_a_dam_factor_restored_from_files_steps_the_same_impact(evaluator, tmp_path):

@@ -141,11 +141,12 @@ class DamModel:
     """
 
     def __init__(self, base, dt_s: float, water_levels_m=None, comm=MPI.COMM_SELF,
-                 strip_m=None, theta: float = 0.5, restored: Optional[dict] = None,
+                 strip_m=None, restored: Optional[dict] = None,
                  patch_y_m=None, saveable: bool = False):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: DamModel is serial (one rank; "
                              "parallel sweeps run one DamModel per process)")
+        theta = base.time_scheme_theta
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
         lo, hi = _levels(base, water_levels_m)
         self.base, self.dt, self.theta, self.comm = base, float(dt_s), float(theta), comm

@@ -268,7 +268,7 @@ def _log_arrays(base, dam, logs, arrays: dict) -> list:
     """Build the log model of each distinct log among ``logs`` at the dam's time step, put
     its arrays in ``arrays`` and return the manifest's entries."""
     from .reuse import LogCache, log_key
-    cache = LogCache(dam.dt, base.h_impact_m, dam.comm)
+    cache = LogCache(dam.dt, base.h_impact_m, dam.comm, dam.theta)
     entries = []
     for s in logs:
         if log_key(s) in cache.models:

@@ -36,7 +36,7 @@ DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "d
                   "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
                   "tailwater_level_m", "uplift_factor", "westergaard", "concrete", "rock",
                   "water_density_kg_m3", "gravity_m_s2", "mesh_size_far_m",
-                  "mesh_size_impact_m", "impact_zone_m", "refine")
+                  "mesh_size_impact_m", "impact_zone_m", "refine", "time_scheme_theta")
 """Parameters fixed by the dam's factorizations: a scenario must share them with the base."""
 
 
@@ -65,12 +65,13 @@ def _ball_key(s: DamScenario) -> tuple:
 
 
 class LogCache:
-    """The log models of one dam at the time step ``dt_s``: one LogMesh per log geometry
-    (its mesh, K and unit mass, every density), one LogModel per log (log_key), each made
-    on first use or restored from a model file. Elements of ``h_m``."""
+    """The log models of one dam at the time step ``dt_s`` and the scheme's ``theta``: one
+    LogMesh per log geometry (its mesh, K and unit mass, every density), one LogModel per
+    log (log_key), each made on first use or restored from a model file. Elements of
+    ``h_m``."""
 
-    def __init__(self, dt_s: float, h_m: float, comm):
-        self.dt, self.h_m, self.comm = float(dt_s), float(h_m), comm
+    def __init__(self, dt_s: float, h_m: float, comm, theta: float):
+        self.dt, self.h_m, self.comm, self.theta = float(dt_s), float(h_m), comm, float(theta)
         self.models: dict = {}
         self.meshes: dict = {}
         self.mesh_s = 0.0
@@ -106,8 +107,8 @@ class LogCache:
     def _model(self, s: DamScenario, mesh, factor=None) -> LogModel:
         return LogModel(
             s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
-            s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.h_m, comm=self.comm, mesh=mesh,
-            dim=s.dim, factor=factor)
+            s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.h_m, theta=self.theta, comm=self.comm,
+            mesh=mesh, dim=s.dim, factor=factor)
 
     def setup_s(self) -> float:
         """Seconds of meshing, factorization and condensation of every log so far."""
@@ -152,7 +153,7 @@ class ScenarioEvaluator:
                                                         strip_m=strip_m,
                                                         patch_y_m=patch_y_m)
         self.dam.static_state(base.water_level_m)
-        self.logs = LogCache(self.dt, base.h_impact_m, self.dam.comm)
+        self.logs = LogCache(self.dt, base.h_impact_m, self.dam.comm, self.dam.theta)
         self._steps_s = 0.0
         self._split: dict = {}  # run_impact's coupled steps, log-only steps, convolution
         self.setup_s = time.perf_counter() - t0

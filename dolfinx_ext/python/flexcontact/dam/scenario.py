@@ -33,7 +33,9 @@ Laboratory's Wood Handbook (2010, ch. 5, Table 5-3a); green loblolly pine has 24
 (3,511 lbf/in²). A log carried by a flood is green: its strength is the green one.
 
 Stage-2 parameters are held and checked here too: the log's speed, the friction coefficient,
-the log's added-mass coefficient and the optional Westergaard added mass of the reservoir.
+the log's added-mass coefficient, the optional Westergaard added mass of the reservoir and
+the time scheme's ``time_scheme_theta`` (0.55: θ = ½ lets a crushing front chatter, which
+makes its force 15–20 % low and sensitive to rounding; docs/dam.md, "The time scheme").
 ``added_mass_coefficient`` C_a multiplies the mass of the water the log displaces, which for
 a floating log equals the log's own mass: m_effective = (1 + C_a) m_log. Its default 0.05
 covers a log moving nearly along its axis: a slender prolate spheroid of the log's aspect
@@ -65,12 +67,12 @@ _DEFAULT_MESH = {2: (3.0, 0.2), 3: (6.0, 0.4)}  # (far, impact) element sizes in
 CRUSHED_PATCH_MESH = {2: (0.00625, 0.1), 3: (0.0125, 0.35)}
 """(mesh_size_contact_m, contact_zone_m) by dimension that resolve the crushed patch of the
 default log (10 m × Ø0.8 m, 10° pitch, 2 m/s, flat end, σ_c = 26.1 MPa) at the peak force by
-at least four elements: the main job's. Measured: in 2D the patch is about 5 cm along the
-end (9 crushing nodes at 6.25 mm); the filtered peak force 1.79, 1.62, 1.43, 1.38, 1.37 MN/m
-at 50, 25, 12.5, 6.25, 3.1 mm. In 3D the patch is a segment of the end, up to 210 pairs at
-their cap at 12.5 mm within the 0.35 m ball; the filtered peak force 0.718 MN at 12.5 mm and
-0.764 MN at 25 mm (far 6 m, impact 0.4 m; docs/dam.md, design formulas). In 3D the ball
-refines the log only (meshes/dam.py)."""
+at least four elements: the main job's. Measured at θ = 0.55 (docs/dam.md, "The time
+scheme"): in 2D the patch is about 5 cm along the end (11 crushing nodes at 6.25 mm); the
+filtered peak force 1.79, 1.62, 1.76, 1.68, 1.64 MN/m at 50, 25, 12.5, 6.25, 3.1 mm (order
+1.0 over the last three, extrapolated 1.60). In 3D the patch is a segment of the end, up to
+210 pairs at their cap at 12.5 mm within the 0.35 m ball (θ = ½). In 3D the ball refines the
+log only (meshes/dam.py)."""
 
 
 MAIN_JOB_MESH = {2: (3.0, 0.2), 3: (3.0, 0.2)}
@@ -120,6 +122,9 @@ class DamScenario:
     friction_mu: float = 0.5
     added_mass_coefficient: float = 0.05
     westergaard: bool = False
+    # θ of stage 2's Moreau–Jean scheme, in [0.5, 1]; above ½ it damps the mesh's highest
+    # frequencies, which a crushing end otherwise excites into chatter (docs/dam.md)
+    time_scheme_theta: float = 0.55
     # materials and strengths
     concrete: Material = CONCRETE
     rock: Material = ROCK

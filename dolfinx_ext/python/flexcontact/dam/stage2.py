@@ -173,6 +173,7 @@ def make_problem(s, stage1, dt_s: float, contact_operator: str = "dense") -> Imp
     return ImpactProblem(
         V, mesh.cell_tags, {"dam": T.DAM, "foundation": T.FOUNDATION, "log": T.LOG},
         materials, stage2_supports(s, V, mesh), contact, dt_s=dt_s, kind=stage1.kind,
+        theta=s.time_scheme_theta,
         initial_velocity={"log": tuple(speed)}, loads=loads["dam"] + loads["foundation"],
         initial_displacement=stage1.u, repair_pairs=False,
         added_mass=westergaard_form(s, mesh) if s.westergaard else None,

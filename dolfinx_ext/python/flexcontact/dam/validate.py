@@ -66,6 +66,9 @@ def _check_types(s):
     for name in ("concrete", "rock", "wood"):
         if not isinstance(getattr(s, name), Material):
             _fail(name, getattr(s, name), "must be a flexcontact.forms.Material")
+    if not (_real(s.time_scheme_theta) and 0.5 <= s.time_scheme_theta <= 1.0):
+        _fail("time_scheme_theta", s.time_scheme_theta,
+              "must be in [0.5, 1] (½: no numerical damping; 1: backward Euler)")
     if not (_real(s.uplift_factor) and 0.0 <= s.uplift_factor <= 1.0):
         _fail("uplift_factor", s.uplift_factor, "must be in [0, 1] (1: full uplift, no drains)")
 
