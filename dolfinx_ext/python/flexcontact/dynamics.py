@@ -440,10 +440,12 @@ class ImpactProblem(StepperViews):
         f = self.outputs.all()
         return [f[0], self.velocity] + f[1:]
 
-    def peak_contact_pressure_Pa(self) -> float:
+    def peak_contact_pressure_Pa(self, slave_only: bool = False) -> float:
         """The largest value of :meth:`fields`' contact pressure (Pa, 0 without contact),
-        without writing any field: cheap enough for every step. Collective."""
-        best = peak_pressure_Pa(self._last_increment(), self.pairs) if self.comm.rank == 0 else 0.0
+        without writing any field: cheap enough for every step. ``slave_only``: over the
+        slave nodes (postprocess.peak_pressure_Pa). Collective."""
+        best = (peak_pressure_Pa(self._last_increment(), self.pairs, slave_only)
+                if self.comm.rank == 0 else 0.0)
         return self.comm.bcast(best, root=0)
 
     def _last_increment(self):

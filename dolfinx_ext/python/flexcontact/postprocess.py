@@ -134,12 +134,17 @@ def impact_step_forces(out: dict, h: float):
                            tangential=np.asarray(out["pair_tangential"]) / h)
 
 
-def peak_pressure_Pa(inc, pairs) -> float:
+def peak_pressure_Pa(inc, pairs, slave_only: bool = False) -> float:
     """The largest nodal contact pressure of :func:`nodal_contact` (Pa, 0 without contact),
     over the nodes that carry DOFs (not rigid targets' reference nodes), as
-    ContactFields.write_back sets it."""
+    ContactFields.write_back sets it. ``slave_only``: over the slave nodes only, whose
+    pressure a crushing interface caps; a master node's, the slave forces spread over its
+    own tributary measure, may exceed the cap."""
     pressure = nodal_contact(inc, pairs)[0]
-    return float(pressure[pairs.dofs[:, 0] >= 0].max(initial=0.0))
+    carries = pairs.dofs[:, 0] >= 0
+    if slave_only:
+        pressure, carries = pressure[:pairs.m], carries[:pairs.m]
+    return float(pressure[carries].max(initial=0.0))
 
 
 class ContactFields:

@@ -187,7 +187,8 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
         if active > 0:
             touched, last_contact = True, i
             peak_principal = max(peak_principal, dam.peak_principal_Pa(static, bd.w, probe))
-            p_peak = max(p_peak, peak_pressure_Pa(impact_step_forces(out, h), pairs))
+            p_peak = max(p_peak, peak_pressure_Pa(impact_step_forces(out, h), pairs,
+                                                  slave_only=True))
         elif after_contact == "convolve" and touched and i + 1 < n:
             # Without impulse the scheme's energy never grows (it loses (θ − ½)(‖Δv‖²_M +
             # ‖Δu‖²_K) a step), so the energy of now bounds the face's motion for good.

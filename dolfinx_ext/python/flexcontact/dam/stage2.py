@@ -73,7 +73,9 @@ class Stage2Result:
     stress_history: list          # (t_s, peak largest principal stress [Pa]) in contact
     impact_point_m: np.ndarray
     offset_m: float
-    peak_contact_pressure_Pa: float  # largest mean pressure of a step (impulse/h/area)
+    # largest mean pressure of a step (impulse / h / tributary area) on the log's front
+    # nodes: the wood's side, which the crushing law caps
+    peak_contact_pressure_Pa: float
     timings_s: dict = field(default_factory=dict)
     section_history: list = field(default_factory=list)  # (t_s, BaseSection) every step
     peak_state: Any = None        # displacement Function at the step of the peak force
@@ -255,7 +257,7 @@ def solve_stage2(scenario, stage1, dt_s: Optional[float] = None,
         if rec.active > 0 and (i % stress_every == 0):
             peak, _ = probe.peak()
             history.append((problem.t, peak))
-            p_peak = max(p_peak, problem.peak_contact_pressure_Pa())
+            p_peak = max(p_peak, problem.peak_contact_pressure_Pa(slave_only=True))
     metrics = contact_metrics(problem.records, dt, filter_window_s=force_filter_window_s(s))
     force_peak = -force_at_filtered_peak(   # the log is the slave: the dam takes the opposite
         [r.normal_force for r in problem.records], [r.slave_force for r in problem.records],
