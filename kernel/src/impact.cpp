@@ -58,6 +58,49 @@ ImpactContact::ImpactContact(int dim, Matrix Fhat, Matrix X, std::vector<Contact
   start();
   W_ = delassus(B_, F_);
   keep_read_rows();
+  find_blocks();
+}
+
+void ImpactContact::find_blocks()
+{
+  // A block may end before DOF k when no entry couples the DOFs before k with those from
+  // k on: no nonzero of the columns before k lies in a row ≥ k, nor one of the columns from
+  // k on in a row < k.
+  const Eigen::Index n = F_.rows();
+  std::vector<Eigen::Index> last(n, -1), first(n, n);
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (F_(i, j) != 0.0)
+      {
+        first[j] = std::min(first[j], i);
+        last[j] = i;
+      }
+  std::vector<Eigen::Index> reach_below(n + 1, -1); // max last row of columns < k
+  for (Eigen::Index k = 0; k < n; ++k)
+    reach_below[k + 1] = std::max(reach_below[k], last[k]);
+  std::vector<Eigen::Index> reach_above(n + 1, n);  // min first row of columns ≥ k
+  for (Eigen::Index k = n - 1; k >= 0; --k)
+    reach_above[k] = std::min(reach_above[k + 1], first[k]);
+  blocks_.assign(1, 0);
+  for (Eigen::Index k = 1; k < n; ++k)
+    if (reach_below[k] < k && reach_above[k] >= k)
+      blocks_.push_back(k);
+  blocks_.push_back(n);
+}
+
+Vector ImpactContact::product(const Vector& x) const
+{
+  if (blocks_.size() <= 2)
+    return F_ * x;
+  Vector y = Vector::Zero(x.size());
+  for (std::size_t b = 0; b + 1 < blocks_.size(); ++b)
+  {
+    const Eigen::Index a = blocks_[b], s = blocks_[b + 1] - a;
+    if ((x.segment(a, s).array() == 0.0).all())
+      continue;
+    y.segment(a, s).noalias() = F_.block(a, a, s, s) * x.segment(a, s);
+  }
+  return y;
 }
 
 void ImpactContact::keep_read_rows()
@@ -148,6 +191,7 @@ void ImpactContact::set_flexibility(Matrix Fhat, double dt_s)
   F_ = std::move(Fhat);
   dt_ = dt_s;
   keep_read_rows();
+  find_blocks();
 }
 
 void ImpactContact::set_pairs(std::vector<ContactPair> pairs, Vector mu, Vector cap)
@@ -256,7 +300,7 @@ ImpactStep ImpactContact::step_condensed(const Eigen::Ref<const Vector>& u_c,
   }
   else if (loaded)
   {
-    Vector dv = F_ * b_c;
+    Vector dv = product(b_c);
     for (Eigen::Index i = 0; i < dv.size(); ++i)
       if (held(i))
         dv[i] = b_c[i];
@@ -265,7 +309,7 @@ ImpactStep ImpactContact::step_condensed(const Eigen::Ref<const Vector>& u_c,
   ImpactStep r = step(u_c, v_c, vfree_c);
   const Vector load = b_c + r.reaction;
   r.velocity_change_c = (load.array() == 0.0).all() ? Vector::Zero(load.size())
-                                                    : Vector(F_ * load);
+                                                    : product(load);
   // r_c is zero on held DOFs, where F_'s zeroed rows leave b̃_c's value to set.
   for (Eigen::Index i = 0; i < load.size(); ++i)
     if (held(i))

@@ -296,6 +296,54 @@ TEST(Impact, CondensedStepOnAFewOfManyContactNodesEqualsTheWholeProduct)
   EXPECT_EQ(r.velocity_change_c.norm(), 0.0);
 }
 
+TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
+{
+  // Two bodies condensed apart, three contact nodes each (DOFs 0–5 and 6–11), three pairs
+  // from the first onto the second, so B reads every DOF: F̂ = diag(F₁, F₂), and the
+  // products go by its two blocks. They must equal the whole products F̂ b and F̂ (b + r)
+  // to round-off, with a body at rest (its part of b zero) and a coupling entry (one block).
+  const int n = 12;
+  Matrix F = Matrix::Zero(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if ((i < 6) == (j < 6))
+        F(i, j) = 1.0 / (1.0 + i % 6 + j % 6) + (i == j ? 1.0 + 0.1 * i : 0.0);
+  const Matrix X = Matrix::Zero(6, 2);
+  std::vector<ContactPair> pairs;
+  for (int k = 0; k < 3; ++k)
+    pairs.push_back(make_pair(k, {3 + k}, {1.0}, vec({1.0, 0.0})));
+  const Vector mu = vec({0.3, 0.3, 0.3});
+  const Vector u = Vector::Zero(n);
+  Vector v(n), b(n);
+  for (int i = 0; i < n; ++i)
+  {
+    v[i] = 0.1 * std::sin(1.0 + i);
+    b[i] = -0.5 + 0.2 * std::cos(2.0 * i);
+  }
+  for (int k = 0; k < 3; ++k)
+    v[2 * k] = -0.5; // the first body's nodes approach the second's
+  auto check = [&](const Matrix& Fh, const Vector& load, int blocks)
+  {
+    ImpactContact c(2, Fh, X, pairs, mu, 0.0, 1e-3, 0.5, {});
+    ImpactContact ref(2, Fh, X, pairs, mu, 0.0, 1e-3, 0.5, {});
+    EXPECT_EQ(c.diagonal_blocks(), blocks);
+    const ImpactStep s = c.step_condensed(u, v, load);
+    const Vector dv = Fh * load;
+    const ImpactStep t = ref.step(u, v, v + dv);
+    ASSERT_EQ(s.active_pairs, 3);
+    EXPECT_LE((s.impulse - t.impulse).norm(), 1e-13 * t.impulse.norm());
+    const Vector expected = dv + Fh * t.reaction;
+    EXPECT_LE((s.velocity_change_c - expected).norm(), 1e-13 * expected.norm());
+  };
+  check(F, b, 2);
+  Vector resting = b;
+  resting.tail(6).setZero(); // the second body unloaded: its block's product skipped
+  check(F, resting, 2);
+  Matrix coupled = F;
+  coupled(1, 7) = coupled(7, 1) = 1e-3;
+  check(coupled, b, 1);
+}
+
 namespace
 {
 /// @brief One contact step of a slave node against a held wall node, W = I on the pair:

@@ -165,6 +165,8 @@ public:
   const Vector& x0() const { return x0_; }                   ///< initial gap, m·d
   const Matrix& W() const { return W_; }          ///< W_eff, m·d × m·d (dense path only)
   const Matrix& flexibility() const { return F_; } ///< F̂, constrained zeroed (dense path only)
+  /// @brief Dense path: how many diagonal blocks F̂'s products go by (1: F̂ whole).
+  int diagonal_blocks() const { return blocks_.empty() ? 0 : static_cast<int>(blocks_.size()) - 1; }
   const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
   const Vector& mu() const { return mu_; }
   double restitution() const { return e_; }
@@ -191,6 +193,11 @@ private:
   void fetch(const std::vector<int>& pairs);
   /// @brief Dense path: the contact DOFs B reads and F̂'s rows there (step_condensed).
   void keep_read_rows();
+  /// @brief Dense path: F̂'s diagonal blocks (blocks_), where no entry couples them.
+  void find_blocks();
+  /// @brief Dense path: F̂ x by F̂'s diagonal blocks, a block whose part of x is zero
+  /// skipped.
+  Vector product(const Vector& x) const;
 
   int dim_;
   Matrix F_;
@@ -207,6 +214,10 @@ private:
   /// when they are at most half of F̂ (otherwise empty and F̂ b̃_c is formed whole).
   std::vector<Eigen::Index> read_;
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> F_read_;
+  /// Dense path: the first DOF of each of F̂'s diagonal blocks and F̂'s size last. Bodies
+  /// condensed apart (a log and a dam) give one block each, and a product by the blocks
+  /// reads their entries only (half of F̂'s for two equal bodies).
+  std::vector<Eigen::Index> blocks_;
   Vector cap_;                     ///< force caps per pair, empty: no crushing
   Vector crush_node_;              ///< crush depth δ per contact node [m]
   Vector last_P_;                  ///< warm start
