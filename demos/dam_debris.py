@@ -226,7 +226,7 @@ if comm.rank == 0:
 # along the face by much less than an element). Time integration:
 # Moreau–Jean on the condensed system, `dt` = 2L/c of the log / 40 by default, with
 # θ = 0.55: a little damping of the mesh's highest frequencies, without which the crushing
-# front chatters and its force comes out 15–20 % low (docs/dam.md, "The time scheme").
+# front chatters and its force comes out about 15 % low (docs/dam.md, "The time scheme").
 #
 # What is measured: the contact force per metre of dam against time, its peak, the
 # contact duration and the impulse, checked against the log's change of momentum

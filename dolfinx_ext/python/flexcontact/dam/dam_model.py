@@ -132,10 +132,10 @@ def face_region_m(base, scenarios, water_levels_m=None, margin_m: float = 1.0):
 
 class DamModel:
     """The dam + foundation of ``base`` (without the log), factored for a sweep at
-    ``dt_s`` and the base's ``time_scheme_theta``; see the module docstring. ``water_levels_m`` = (lo, hi): the range of water
-    levels of the sweep (the face has nodes at both). ``strip_m``: the face strip's
-    elevations (default_strip_m); in 3D ``patch_y_m``: its y range (default_patch_y_m).
-    Serial (``comm`` of one rank).
+    ``dt_s`` and the base's ``time_scheme_theta``; see the module docstring.
+    ``water_levels_m`` = (lo, hi): the range of water levels of the sweep (the face has
+    nodes at both). ``strip_m``: the face strip's elevations (default_strip_m); in 3D
+    ``patch_y_m``: its y range (default_patch_y_m). Serial (``comm`` of one rank).
 
     Counters: ``factorizations`` and ``back_substitutions``, dicts by stage.
     """

@@ -35,7 +35,7 @@ Laboratory's Wood Handbook (2010, ch. 5, Table 5-3a); green loblolly pine has 24
 Stage-2 parameters are held and checked here too: the log's speed, the friction coefficient,
 the log's added-mass coefficient, the optional Westergaard added mass of the reservoir and
 the time scheme's ``time_scheme_theta`` (0.55: θ = ½ lets a crushing front chatter, which
-makes its force 15–20 % low and sensitive to rounding; docs/dam.md, "The time scheme").
+makes its force about 15 % low and sensitive to rounding; docs/dam.md, "The time scheme").
 ``added_mass_coefficient`` C_a multiplies the mass of the water the log displaces, which for
 a floating log equals the log's own mass: m_effective = (1 + C_a) m_log. Its default 0.05
 covers a log moving nearly along its axis: a slender prolate spheroid of the log's aspect
