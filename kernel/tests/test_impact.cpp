@@ -322,7 +322,7 @@ TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
   }
   for (int k = 0; k < 3; ++k)
     v[2 * k] = -0.5; // the first body's nodes approach the second's
-  auto check = [&](const Matrix& Fh, const Vector& load, int blocks)
+  auto check = [&](const Matrix& Fh, const Vector& load, int blocks, int closed = 3)
   {
     ImpactContact c(2, Fh, X, pairs, mu, 0.0, 1e-3, 0.5, {});
     ImpactContact ref(2, Fh, X, pairs, mu, 0.0, 1e-3, 0.5, {});
@@ -330,7 +330,7 @@ TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
     const ImpactStep s = c.step_condensed(u, v, load);
     const Vector dv = Fh * load;
     const ImpactStep t = ref.step(u, v, v + dv);
-    ASSERT_EQ(s.active_pairs, 3);
+    ASSERT_EQ(s.active_pairs, closed);
     EXPECT_LE((s.impulse - t.impulse).norm(), 1e-13 * t.impulse.norm());
     const Vector expected = dv + Fh * t.reaction;
     EXPECT_LE((s.velocity_change_c - expected).norm(), 1e-13 * expected.norm());
@@ -342,6 +342,10 @@ TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
   Matrix coupled = F;
   coupled(1, 7) = coupled(7, 1) = 1e-3;
   check(coupled, b, 1);
+  // One pair closing: its reaction has 2 of each block's 6 DOFs, read by those columns.
+  v[2] = v[4] = 0.5;
+  check(F, b, 2, 1);
+  check(F, resting, 2, 1);
 }
 
 namespace

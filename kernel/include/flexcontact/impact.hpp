@@ -196,7 +196,8 @@ private:
   /// @brief Dense path: F̂'s diagonal blocks (blocks_), where no entry couples them.
   void find_blocks();
   /// @brief Dense path: F̂ x by F̂'s diagonal blocks, a block whose part of x is zero
-  /// skipped.
+  /// skipped, and one where x is mostly zero (a contact reaction) read by its nonzero
+  /// columns only.
   Vector product(const Vector& x) const;
 
   int dim_;
