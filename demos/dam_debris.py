@@ -11,7 +11,9 @@
 # its foundation, and the log a round one, pitched 10° (`--log-pitch`, `--log-yaw`), whose
 # front end crushes at the wood's crushing strength (docs/crushing.md); the log's end is
 # refined about the first-contact point so that the crushed patch at the peak force spans at
-# least four elements (CRUSHED_PATCH_MESH), and the rest has elements of 0.2 m on the log and
+# least four elements (CRUSHED_PATCH_MESH: in 3D 12.5 mm within 0.35 m of it and 5 cm deep
+# behind the end, `--contact-size`, `--contact-zone`, `--contact-layer`), and the rest has
+# elements of 0.2 m on the log and
 # near it, 3 m far from it (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study
 # below says why). `--elastic-end` keeps the end elastic (the upper bound
 # of the force); `--log-end` shapes it (flat, chamfered, rounded). `--dim 2` runs the
@@ -81,6 +83,10 @@ parser.add_argument("--contact-size", type=float, default=None,
                          "the impact zone's)")
 parser.add_argument("--contact-zone", type=float, default=None,
                     help="radius (m) of the refined ball about the first-contact point")
+parser.add_argument("--contact-layer", type=float, default=None,
+                    help="depth (m) behind the log's end within which the ball keeps "
+                         "--contact-size; deeper, elements grow (default: CRUSHED_PATCH_MESH "
+                         "of the dimension: 5 cm in 3D, the whole ball in 2D)")
 parser.add_argument("--far-size", type=float, default=None,
                     help="element size far from the log, m (default: MAIN_JOB_MESH, 3 m)")
 parser.add_argument("--impact-size", type=float, default=None,
@@ -126,7 +132,7 @@ t_start = time.perf_counter()
 # %%
 from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
 crushes = not args.elastic_end
-size, zone = CRUSHED_PATCH_MESH[args.dim] if crushes else (None, 0.1)
+size, zone, layer = CRUSHED_PATCH_MESH[args.dim] if crushes else (None, 0.1, None)
 far_size, impact_size = MAIN_JOB_MESH[args.dim]
 scenario = DamScenario(
     dim=args.dim, dam_width_m=args.dam_width, refine=args.refine,
@@ -139,6 +145,7 @@ scenario = DamScenario(
     log_end_shape=args.log_end, log_end_chamfer_m=args.end_chamfer,
     log_end_radius_m=args.end_radius,
     mesh_size_contact_m=args.contact_size or size, contact_zone_m=args.contact_zone or zone,
+    contact_layer_m=args.contact_layer or layer,
     mesh_size_far_m=args.far_size or far_size,
     mesh_size_impact_m=args.impact_size or impact_size)
 folder = fc.results_folder("dam_debris")

@@ -106,10 +106,10 @@ for length in args.lengths:
     gap = max(mesh_gap_m(stage1), base.log_gap_m)
     crushing = {}  # end shape -> (scenario, stage 1, mesh gap)
     for end in ([] if args.no_crushing else args.crushing_ends):
-        size, zone = CRUSHED_PATCH_MESH[args.dim]
+        size, zone, layer = CRUSHED_PATCH_MESH[args.dim]
         size = args.contact_size or size
         sc = base.replace(log_end_crushes=True, log_end_shape=end, mesh_size_contact_m=size,
-                          contact_zone_m=zone)
+                          contact_zone_m=zone, contact_layer_m=layer)
         st1 = solve_stage1(sc, comm=comm)
         crushing[end] = (sc, st1, max(mesh_gap_m(st1), sc.log_gap_m))
     for v in args.speeds:

@@ -92,13 +92,13 @@ def mesh_uniform(dim: int, h: float) -> None:
         gmsh.option.setNumber("Mesh.MeshSizeMax", 1e22)
 
 
-def mesh_with_balls(dim: int, h: float, balls=()) -> None:
+def mesh_with_balls(dim: int, h: float, balls=(), layer=None) -> None:
     """Mesh the current model's ``dim``-entities with elements of size ``h``, capped inside
-    each ball ``(size, x, y, z, radius, thickness)`` as in :func:`size_field`; no ball: as
-    :func:`mesh_uniform`."""
+    each ball ``(size, x, y, z, radius, thickness)`` as in :func:`size_field` (``layer``
+    too); no ball: as :func:`mesh_uniform`."""
     if not balls:
         return mesh_uniform(dim, h)
-    _background([_ball(*b, h) for b in balls])
+    _background([_layered(_ball(*b, h), b[0], h, layer) for b in balls])
     gmsh.option.setNumber("Mesh.MeshSizeMax", h)
     try:
         gmsh.model.mesh.generate(dim)
@@ -117,15 +117,18 @@ def physical(dim: int, entities, tag: int, name: str):
 
 def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float,
                dist_far: float, points_per_curve: int = 20, boxes=(), balls=(),
-               balls_only_in=None):
+               balls_only_in=None, layer=None):
     """Background mesh size (m): h_near within dist_near of the ``dim``-entities (curves or
     surfaces), growing linearly to h_far at dist_far. ``boxes``: extra caps
     ``(size, x0, y0, z0, x1, y1, z1)``; inside such a box the size never exceeds ``size``.
     ``balls``: caps ``(size, x, y, z, radius, thickness)``, the size inside the ball of that
     radius, blending to the rest over ``thickness``; ``balls_only_in``: volume tags to which
     the balls are restricted (with their faces, curves and points: gmsh 4.11 applies a
-    restriction to the listed entities only). Sizes from points and curvature are switched
-    off."""
+    restriction to the listed entities only). ``layer`` = (entities, entity_dim, depth_m):
+    a ball's size holds only within ``depth_m`` of those entities (curves or surfaces), and
+    grows beyond at the rate 1/2 of the ball's blend (a crushed patch needs fine elements
+    along the end it lies on, not deep behind it). Sizes from points and curvature are
+    switched off."""
     field = gmsh.model.mesh.field
     f_dist = field.add("Distance")
     field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[dim], list(entities))  # 4.8 names
@@ -145,7 +148,7 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
         field.setNumber(f_box, "VOut", h_far)
         fields.append(f_box)
     for ball in balls:
-        f_ball = _ball(*ball, h_far)
+        f_ball = _layered(_ball(*ball, h_far), ball[0], h_far, layer)
         if balls_only_in:
             f_ball = _restricted(f_ball, balls_only_in)
         fields.append(f_ball)
@@ -160,6 +163,28 @@ def _ball(size, x, y, z, radius, thickness, v_out) -> int:
                      ("Thickness", thickness), ("VIn", size), ("VOut", v_out)):
         field.setNumber(f, key, val)
     return f
+
+
+def _layered(f_ball: int, size: float, h: float, layer) -> int:
+    """The larger of ``f_ball`` and a size that is ``size`` within ``depth_m`` of the
+    layer's entities and grows to ``h`` over 2(h − size) beyond; ``layer`` None: ``f_ball``
+    itself."""
+    if layer is None:
+        return f_ball
+    entities, entity_dim, depth = layer
+    field = gmsh.model.mesh.field
+    f_dist = field.add("Distance")
+    field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[entity_dim], list(entities))
+    # Distances are to sample points: 100 per curve put them 8 mm apart on a 0.8 m end.
+    field.setNumber(f_dist, "NumPointsPerCurve", 100)
+    f_thr = field.add("Threshold")
+    field.setNumber(f_thr, "InField", f_dist)
+    for key, val in (("SizeMin", size), ("SizeMax", h), ("DistMin", depth),
+                     ("DistMax", depth + 2.0 * (h - size))):
+        field.setNumber(f_thr, key, val)
+    f_max = field.add("Max")
+    field.setNumbers(f_max, "FieldsList", [f_ball, f_thr])
+    return f_max
 
 
 def _background(fields: list) -> None:

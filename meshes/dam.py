@@ -67,14 +67,25 @@ def profile_points(s) -> list:
     return [heel] + down + up
 
 
-def _refine_near_log(s, log_entities, dim, log_volume=None):
-    """Sizes about the log; ``log_volume`` (3D): the contact ball refines the log only."""
+def _refine_near_log(s, log_entities, dim, log_volume=None, front=()):
+    """Sizes about the log; ``log_volume`` (3D): the contact ball refines the log only;
+    ``front``: the log's front-end curves (2D) or faces (3D), behind which the ball's
+    size holds only within ``contact_layer_m`` when the scenario sets it."""
     near = s.impact_zone_m
     far = near + 2.0 * (s.h_far_m - s.h_impact_m)  # growth rate 1/2: well-shaped grading
     _gmsh.size_field(log_entities, dim, s.h_impact_m, s.h_far_m, near, far,
                      points_per_curve=max(20, int(4 * s.log_length_m / s.h_impact_m)),
                      balls=_contact_ball(s),
-                     balls_only_in=[log_volume] if log_volume is not None else None)
+                     balls_only_in=[log_volume] if log_volume is not None else None,
+                     layer=_contact_layer(s, front, dim))
+
+
+def _contact_layer(s, front, dim):
+    """The contact ball's layer for _gmsh.size_field: within ``contact_layer_m`` of the
+    log's front end (None: the whole ball)."""
+    if s.contact_layer_m is None or not len(front):
+        return None
+    return (list(front), dim, s.contact_layer_m)
 
 
 def _contact_ball(s) -> tuple:
@@ -123,7 +134,8 @@ def _model_2d(s, info):
               DAM_DOWNSTREAM: downstream, **log_curves}
     for tag, curves in groups.items():
         _gmsh.physical(1, curves, tag, NAMES[tag])
-    _refine_near_log(s, [c for cs in log_curves.values() for c in cs], 1)
+    _refine_near_log(s, [c for cs in log_curves.values() for c in cs], 1,
+                     front=log_curves[LOG_FRONT])
     gmsh.model.mesh.generate(2)
     return info
 
@@ -222,7 +234,8 @@ def _model_3d(s, info):
     # mesher caught it only below h_impact ≈ 0.3 m (at 0.4 m the face kept 0.4 m
     # elements, at 0.3 m it had 200,000 more cells), so the dam's near field jumped with
     # h_impact; it is now h_impact at every mesh, and the mesh study refines it evenly.
-    _refine_near_log(s, faces[LOG_MANTLE] + faces[LOG_FRONT] + faces[LOG_BACK], 2, log_vol)
+    _refine_near_log(s, faces[LOG_MANTLE] + faces[LOG_FRONT] + faces[LOG_BACK], 2, log_vol,
+                     front=faces[LOG_FRONT])
     gmsh.model.mesh.generate(3)
     return info
 
@@ -383,7 +396,9 @@ def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2, ball=None):
     ``log_front``) at x = +L/2, shaped by ``end`` (a :class:`~.log_end.LogEnd`; None: flat);
     elements of size ``h_m``, and of ``size`` within ``zone`` of the point (a, b) (3D:
     (a, b, 0)) when ``ball`` = (a, b, size, zone) is given: the crushed patch's refinement
-    (blending to ``h_m`` over 2(h_m − size), as the whole mesh's contact ball). In 2D a
+    (blending to ``h_m`` over 2(h_m − size), as the whole mesh's contact ball); with a fifth
+    entry ``layer``, only within ``layer`` (m) of the front end, growing behind it at the
+    same rate (the scenario's ``contact_layer_m``). In 2D a
     plane-strain slab ``length_m`` × ``diameter_m`` (facets ``log_front``, ``log_back``,
     ``log_upper``, ``log_lower``), in 3D a round log (faces ``log_front``, ``log_back``,
     ``log_mantle``). Cells ``log``. Returns (mesh, cell_tags, facet_tags, info)."""
@@ -392,21 +407,22 @@ def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2, ball=None):
                                            ("h_m", h_m)))
     end = (LogEnd() if end is None else end).check(D, ("end.shape", "end.chamfer_m",
                                                        "end.radius_m"))
-    balls = ()
+    balls, layer = (), None
     if ball is not None:
-        a, b, size, zone = (float(v) for v in ball)
+        a, b, size, zone = (float(v) for v in ball[:4])
         balls = (ball_cap(size, (a, b, 0.0), zone, h),)
+        layer = float(ball[4]) if len(ball) > 4 else None
     if dim == 3:
         from .dam_apart_3d import build_log_3d
-        return build_log_3d(comm, L, D, h, end, balls)
+        return build_log_3d(comm, L, D, h, end, balls, layer)
     if dim != 2:
         raise InputError(f"dim={dim!r}: the log is meshed in 2D or 3D")
     info = dict(dim=2, length_m=L, diameter_m=D, h_m=h, end_shape=end.shape)
-    return _gmsh.generate(comm, "log2d", lambda: _model_log_2d(L, D, h, end, info, balls),
-                          gdim=2)
+    return _gmsh.generate(
+        comm, "log2d", lambda: _model_log_2d(L, D, h, end, info, balls, layer), gdim=2)
 
 
-def _model_log_2d(L, D, h, end, info, balls=()):
+def _model_log_2d(L, D, h, end, info, balls=(), layer=None):
     import gmsh
     geo = gmsh.model.geo
     curves, surface = log_outline_2d(geo, L, 0.5 * D, end, lambda x, y: (x, y))
@@ -414,5 +430,6 @@ def _model_log_2d(L, D, h, end, info, balls=()):
     _gmsh.physical(2, [surface], LOG, NAMES[LOG])
     for tag in (LOG_LOWER, LOG_FRONT, LOG_UPPER, LOG_BACK):
         _gmsh.physical(1, curves[tag], tag, NAMES[tag])
-    _gmsh.mesh_with_balls(2, h, balls)
+    _gmsh.mesh_with_balls(2, h, balls,
+                          None if layer is None else (curves[LOG_FRONT], 1, layer))
     return info

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import _gmsh
 from .dam import dam_faces_3d, downstream_points, log_faces_3d, log_solid
-from .dam_tags import DAM, FOUNDATION, LOG, NAMES
+from .dam_tags import DAM, FOUNDATION, LOG, LOG_FRONT, NAMES
 from flexcontact.errors import InputError
 
 
@@ -78,23 +78,26 @@ def _model(s, info, face_levels, strip, patch_y):
     return info
 
 
-def build_log_3d(comm, L: float, D: float, h: float, end, balls=()):
+def build_log_3d(comm, L: float, D: float, h: float, end, balls=(), layer=None):
     """The round log (length ``L``, diameter ``D``, front end ``end``, checked) in its own
-    frame, elements of size ``h`` (capped in ``balls``, _gmsh.mesh_with_balls)."""
+    frame, elements of size ``h`` (capped in ``balls``, _gmsh.mesh_with_balls; only within
+    ``layer`` m of the front end when given)."""
     info = dict(dim=3, length_m=L, diameter_m=D, h_m=h, end_shape=end.shape)
-    return _gmsh.generate(comm, "log3d", lambda: _model_log(L, D, h, end, info, balls),
-                          gdim=3)
+    return _gmsh.generate(comm, "log3d",
+                          lambda: _model_log(L, D, h, end, info, balls, layer), gdim=3)
 
 
-def _model_log(L, D, h, end, info, balls=()):
+def _model_log(L, D, h, end, info, balls=(), layer=None):
     import gmsh
     occ = gmsh.model.occ
     centre, axis = np.zeros(3), np.array([1.0, 0.0, 0.0])
     vol = log_solid(occ, centre, axis, L, 0.5 * D, end)
     occ.synchronize()
     _gmsh.physical(3, [vol], LOG, NAMES[LOG])
-    for tag, fs in log_faces_3d(vol, centre, axis, L, 0.5 * D, end).items():
+    faces = log_faces_3d(vol, centre, axis, L, 0.5 * D, end)
+    for tag, fs in faces.items():
         _gmsh.physical(2, fs, tag, NAMES[tag])
-    _gmsh.mesh_with_balls(3, h, balls)
+    _gmsh.mesh_with_balls(3, h, balls,
+                          None if layer is None else (faces[LOG_FRONT], 2, layer))
     return info
 

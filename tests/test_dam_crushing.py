@@ -104,8 +104,46 @@ def test_the_contact_ball_refines_the_first_contact_point():
     assert sizes["fine"][1] < 2 * sizes["coarse"][1]
 
 
+@pytest.mark.parametrize("dim, layer", [(3, 0.05), (2, 0.02)])
+def test_a_contact_layer_keeps_the_end_and_coarsens_behind_it(dim, layer):
+    """contact_layer_m: the ball keeps its size only that deep behind the log's end. The
+    end itself is meshed as with the whole ball (the same nodes, to 1e-12 m: on the end the
+    size field is the ball's), and the log has fewer nodes (at the main job's 3D sizes
+    18,927 DOFs against 54,957; here a coarser shaft). Behind the layer, past the blend,
+    no element has the ball's size."""
+    from flexcontact.dam.log_model import LogMesh, contact_ball
+    meshes = {}
+    for name, depth in (("ball", None), ("layer", layer)):
+        s = DamScenario(dim=dim, mesh_size_far_m=6.0, mesh_size_impact_m=0.4,
+                        mesh_size_contact_m=0.025 if dim == 3 else 0.00625,
+                        contact_zone_m=0.35 if dim == 3 else 0.1, contact_layer_m=depth)
+        meshes[name] = LogMesh(s.log_length_m, s.log_diameter_m, 10e9, 0.3, h_m=s.h_impact_m,
+                               dim=dim, ball=contact_ball(s))
+    front = {k: np.unique(np.round(m.x_nodes[m.front_dofs[::dim] // dim], 12), axis=0)
+             for k, m in meshes.items()}
+    assert front["layer"].shape == front["ball"].shape
+    assert np.allclose(front["layer"], front["ball"], rtol=0, atol=1e-12)
+    n = {k: m.x_nodes.shape[0] for k, m in meshes.items()}
+    assert n["layer"] < 0.8 * n["ball"], n
+    # Inside the ball but 4 ball sizes and more behind the layer, the size has grown by half
+    # that depth: the closest two nodes there are over 1.5 ball sizes apart; with the whole
+    # ball they are closer.
+    from scipy.spatial import cKDTree
+    h_c, zone = s.h_contact_m, s.contact_zone_m
+    ball = np.array(contact_ball(s)[:2] + (0.0,))[:dim]
+    closest = {}
+    for k, m in meshes.items():
+        depth = 0.5 * s.log_length_m - m.x_nodes[:, 0]
+        x = m.x_nodes[(depth > layer + 4 * h_c) & (depth < 0.8 * zone)
+                      & (np.linalg.norm(m.x_nodes - ball, axis=1) < 0.8 * zone)]
+        closest[k] = cKDTree(x).query(x, k=2)[0][:, 1].min()
+    assert closest["layer"] > 1.5 * h_c > closest["ball"], closest
+
+
 @pytest.mark.parametrize("change, words", [({"mesh_size_contact_m": 0.0}, "mesh_size_contact_m"),
                                            ({"contact_zone_m": -1.0}, "contact_zone_m"),
+                                           ({"contact_layer_m": 0.0}, "contact_layer_m"),
+                                           ({"contact_layer_m": float("nan")}, "contact_layer_m"),
                                            ({"log_end_crushes": "yes"}, "log_end_crushes"),
                                            ({"wood_crushing_strength_Pa": 0.0},
                                             "wood_crushing_strength_Pa")])
@@ -165,9 +203,9 @@ def refined_patch_runs():
     from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
     from flexcontact.sweep.monolithic import MonolithicEvaluator
     far, impact = MAIN_JOB_MESH[2]
-    h_c, zone = CRUSHED_PATCH_MESH[2]
+    h_c, zone, layer = CRUSHED_PATCH_MESH[2]
     s = DamScenario(mesh_size_far_m=far, mesh_size_impact_m=impact, mesh_size_contact_m=h_c,
-                    contact_zone_m=zone, log_end_crushes=True)
+                    contact_zone_m=zone, contact_layer_m=layer, log_end_crushes=True)
     ev = ScenarioEvaluator(s, comm=COMM)
     f = ev.evaluate(s)
     assert ev.log_model(s).mesh.ball is not None
@@ -220,9 +258,9 @@ def test_the_damped_scheme_makes_the_crushing_front_reproducible():
     (measured 2e-13); 1e-9 here."""
     from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
     far, impact = MAIN_JOB_MESH[2]
-    h_c, zone = CRUSHED_PATCH_MESH[2]
+    h_c, zone, layer = CRUSHED_PATCH_MESH[2]
     s = DamScenario(mesh_size_far_m=far, mesh_size_impact_m=impact, mesh_size_contact_m=h_c,
-                    contact_zone_m=zone, log_end_crushes=True)
+                    contact_zone_m=zone, contact_layer_m=layer, log_end_crushes=True)
     assert s.time_scheme_theta == 0.55
     r1 = solve_stage1(s, comm=COMM)
     runs = []

@@ -61,13 +61,16 @@ def contact_ball(s) -> Optional[tuple]:
     one log. A round log is the same log turned about its axis, so in 3D the ball sits at
     azimuth 0 and :func:`placement` turns the log to the point's azimuth: a flat or
     chamfered end's first contact is on its rim whatever the pitch and yaw, so one log
-    serves them all; a rounded end's moves along the cap with the angle."""
+    serves them all; a rounded end's moves along the cap with the angle. With
+    ``contact_layer_m`` set, a fifth entry: the ball refines only that deep behind the
+    front end."""
     if s.mesh_size_contact_m is None or s.h_contact_m >= s.h_impact_m:
         return None
     q = _first_contact_local(s)
     b = q[1] if s.dim == 2 else math.hypot(q[1], q[2])
-    return (round(float(q[0]), 6), round(float(b), 6), float(s.h_contact_m),
+    ball = (round(float(q[0]), 6), round(float(b), 6), float(s.h_contact_m),
             float(s.contact_zone_m))
+    return ball if s.contact_layer_m is None else ball + (float(s.contact_layer_m),)
 
 
 def _first_contact_local(s) -> np.ndarray:
