@@ -67,7 +67,9 @@ def run(ratio, n, crushing=True, comm=MPI.COMM_WORLD, extra_periods=2.0, courant
         crushing=np.array([h["crushing"] for h in hist]),
         contact=np.array([h["contact"] for h in hist]),
         balance=np.array([h["balance_error"] for h in hist]),
-        initial=np.array(p.energy.initial))
+        initial=np.array(p.energy.initial),
+        chatter=comm.bcast((p.crush_chatter.flips, p.crush_chatter.capped_steps)
+                           if p.crush_chatter is not None else None))
 
 
 if __name__ == "__main__":

@@ -275,6 +275,31 @@ def test_the_damped_scheme_makes_the_crushing_front_reproducible():
     assert a["episodes"] == b["episodes"]
 
 
+def test_a_chattering_front_at_theta_one_half_is_warned_of():
+    """The same scenario at θ = ½ chatters: ImpactProblem's watch (crush_watch.py) warns,
+    naming θ = 0.55; measured, 101 flips in 282 capped pair-steps over the run (at θ =
+    0.55, unwatched, 10 in 348). At the scenario's own θ = 0.55 there is no watch."""
+    import warnings
+    from flexcontact.crush_watch import CHATTER_RATE, CrushingChatterWarning
+    from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
+    far, impact = MAIN_JOB_MESH[2]
+    h_c, zone, layer = CRUSHED_PATCH_MESH[2]
+    s = DamScenario(mesh_size_far_m=far, mesh_size_impact_m=impact, mesh_size_contact_m=h_c,
+                    contact_zone_m=zone, contact_layer_m=layer, log_end_crushes=True,
+                    time_scheme_theta=0.5)
+    r1 = solve_stage1(s, comm=COMM)
+    with pytest.warns(CrushingChatterWarning, match="theta=0.55"):
+        r = solve_stage2(s, r1, dt_s=sweep_time_step_s([s]), duration_s=response_duration_s(s))
+    watch = r.problem.crush_chatter
+    assert watch.flips >= CHATTER_RATE * watch.capped_steps
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CrushingChatterWarning)
+        damped = s.replace(time_scheme_theta=0.55)
+        r = solve_stage2(damped, r1, dt_s=sweep_time_step_s([damped]),
+                         duration_s=response_duration_s(damped))
+    assert r.problem.crush_chatter is None
+
+
 def test_the_time_scheme_theta_is_checked():
     from flexcontact.errors import InputError
     for bad in (0.4, 1.5, float("nan"), "0.55"):

@@ -38,6 +38,7 @@ import dolfinx.fem
 from . import _cpp, impact_setup as setup
 from ._cpp import SolverOptions
 from .condensation import Condensation
+from .crush_watch import CrushChatterWatch
 from .energy import EnergyAccount
 from .factor_path import FactorImpactCondensation
 from .names import (CONTACT_OPERATORS, ContactOperator, check_chain, check_flexibility_method,
@@ -159,6 +160,9 @@ class ImpactProblem(StepperViews):
         self.options = solver if solver is not None else SolverOptions()
         self.timings, self.records = {}, []
         self.t = 0.0
+        crushes = any(getattr(i, "crushing_strength_Pa", None) is not None
+                      for i in self.interfaces)
+        self._chatter = CrushChatterWatch() if crushes and self.theta == 0.5 else None
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
         dx = ufl.Measure("dx", domain=self.msh, subdomain_data=cell_tags)
         self.a_form = dolfinx.fem.form(forms.elasticity_form(u, v, materials, dx, kind,
@@ -419,10 +423,18 @@ class ImpactProblem(StepperViews):
                 if "crush_depth" in out else 0.0,
                 crushed_volume_m3=float(np.dot(out["crush_depth"], self.pairs.tributary))
                 if "crush_depth" in out else 0.0)
+            if self._chatter is not None:
+                self._chatter.observe(rec.step, (s == CRUSH) & closed, closed)
         rec = self.comm.bcast(rec, root=0)
         rec.energy = self.energy.history[-1]
         rec.momentum = self._last_momentum
         return rec
+
+    @property
+    def crush_chatter(self) -> Optional[CrushChatterWatch]:
+        """The watch over a crushing front's chatter (crush_watch.py): only at θ = ½ with a
+        crushing interface, else None. Rank 0 counts; other ranks hold zeros."""
+        return self._chatter
 
     # ---- output -----------------------------------------------------------------------
     def _to_functions(self) -> None:
