@@ -38,6 +38,16 @@ def box(dim, interface_x=None):
     return dolfinx.fem.Function(compat.vector_space(msh)), tags
 
 
+def reach_x(dim, interface_x) -> float:
+    """The largest x of the cells tagged 1 by :func:`box` (their centroid left of
+    ``interface_x``): the interface runs through cells, so material 1 reaches past it."""
+    u, tags = box(dim, interface_x)
+    msh = u.function_space.mesh
+    cells = tags.indices[tags.values == 1]
+    x = compat.geometry_x(msh)[compat.geometry_dofmap(msh)[cells]][..., 0].max(initial=-np.inf)
+    return MPI.COMM_WORLD.allreduce(float(x), op=MPI.MAX)
+
+
 def stress(material, eps, kind):
     """The 3×3 stress (Pa) of the 3×3 strain ``eps`` (plane strain: ε_zz = 0)."""
     E, nu = material.E_Pa, material.nu
