@@ -109,8 +109,8 @@ def test_a_contact_layer_keeps_the_end_and_coarsens_behind_it(dim, layer):
     """contact_layer_m: the ball keeps its size only that deep behind the log's end. The
     end itself is meshed as with the whole ball (the same nodes, to 1e-12 m: on the end the
     size field is the ball's), and the log has fewer nodes (at the main job's 3D sizes
-    18,927 DOFs against 54,957; here a coarser shaft). Behind the layer, past the blend,
-    no element has the ball's size."""
+    18,927 DOFs against 54,957; here a coarser shaft). Inside the ball, behind the layer,
+    the elements grow."""
     from flexcontact.dam.log_model import LogMesh, contact_ball
     meshes = {}
     for name, depth in (("ball", None), ("layer", layer)):
@@ -133,8 +133,8 @@ def test_a_contact_layer_keeps_the_end_and_coarsens_behind_it(dim, layer):
     ball = np.array(contact_ball(s)[:2] + (0.0,))[:dim]
     closest = {}
     for k, m in meshes.items():
-        depth = 0.5 * s.log_length_m - m.x_nodes[:, 0]
-        x = m.x_nodes[(depth > layer + 4 * h_c) & (depth < 0.8 * zone)
+        behind = 0.5 * s.log_length_m - m.x_nodes[:, 0]
+        x = m.x_nodes[(behind > layer + 4 * h_c) & (behind < 0.8 * zone)
                       & (np.linalg.norm(m.x_nodes - ball, axis=1) < 0.8 * zone)]
         closest[k] = cKDTree(x).query(x, k=2)[0][:, 1].min()
     assert closest["layer"] > 1.5 * h_c > closest["ball"], closest
@@ -277,8 +277,8 @@ def test_the_damped_scheme_makes_the_crushing_front_reproducible():
 
 def test_a_chattering_front_at_theta_one_half_is_warned_of():
     """The same scenario at θ = ½ chatters: ImpactProblem's watch (crush_watch.py) warns,
-    naming θ = 0.55; measured, 101 flips in 282 capped pair-steps over the run (at θ =
-    0.55, unwatched, 10 in 348). At the scenario's own θ = 0.55 there is no watch."""
+    naming θ = 0.55 (measured: at step 90; 189 flips in 425 capped pair-steps over this
+    run). At the scenario's own θ = 0.55 there is no watch."""
     import warnings
     from flexcontact.crush_watch import CHATTER_RATE, CrushingChatterWarning
     from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
