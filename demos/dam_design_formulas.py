@@ -20,10 +20,10 @@
 # in the table.
 #
 # Run: `/usr/bin/python3 demos/dam_design_formulas.py [--speeds 1 2 4] [--lengths 5 10]
-# [--dim 3] [--no-crushing] [--crushing-ends flat rounded] [--contact-size 0.025]`; about a
-# minute per elastic run of the 3D coarse mesh here, 2–2.5 minutes per crushing run on the
-# resolving 12.5 mm mesh, about half a minute on 25 mm; `--dim 2` takes about a minute in all. Results in `results/dam_design_formulas/` (CSV,
-# markdown table, PNG, summary.json).
+# [--dim 3] [--no-crushing] [--crushing-ends flat rounded] [--contact-size 0.025]`; the
+# whole 3D table (18 runs) takes about 10 minutes here on the resolving 12.5 mm mesh, one
+# minute with `--contact-size 0.025`; `--dim 2` takes about 15 s. Results in
+# `results/dam_design_formulas/` (CSV, markdown table, PNG, summary.json).
 
 # %%
 import argparse
