@@ -130,16 +130,7 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
     along the end it lies on, not deep behind it). Sizes from points and curvature are
     switched off."""
     field = gmsh.model.mesh.field
-    f_dist = field.add("Distance")
-    field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[dim], list(entities))  # 4.8 names
-    field.setNumber(f_dist, "NumPointsPerCurve", points_per_curve)
-    f_thr = field.add("Threshold")
-    field.setNumber(f_thr, "InField", f_dist)
-    field.setNumber(f_thr, "SizeMin", h_near)
-    field.setNumber(f_thr, "SizeMax", h_far)
-    field.setNumber(f_thr, "DistMin", dist_near)
-    field.setNumber(f_thr, "DistMax", dist_far)
-    fields = [f_thr]
+    fields = [_threshold(entities, dim, h_near, h_far, dist_near, dist_far, points_per_curve)]
     for size, *box in boxes:
         f_box = field.add("Box")
         for key, val in zip(("XMin", "YMin", "ZMin", "XMax", "YMax", "ZMax"), box):
@@ -153,6 +144,22 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
             f_ball = _restricted(f_ball, balls_only_in)
         fields.append(f_ball)
     _background(fields)
+
+
+def _threshold(entities, dim: int, size_min: float, size_max: float, dist_min: float,
+               dist_max: float, points_per_curve: int) -> int:
+    """A Threshold field: ``size_min`` within ``dist_min`` of the ``dim``-entities (curves or
+    surfaces), growing linearly to ``size_max`` at ``dist_max``."""
+    field = gmsh.model.mesh.field
+    f_dist = field.add("Distance")
+    field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[dim], list(entities))  # 4.8 names
+    field.setNumber(f_dist, "NumPointsPerCurve", points_per_curve)
+    f_thr = field.add("Threshold")
+    field.setNumber(f_thr, "InField", f_dist)
+    for key, val in (("SizeMin", size_min), ("SizeMax", size_max), ("DistMin", dist_min),
+                     ("DistMax", dist_max)):
+        field.setNumber(f_thr, key, val)
+    return f_thr
 
 
 def _ball(size, x, y, z, radius, thickness, v_out) -> int:
@@ -173,15 +180,8 @@ def _layered(f_ball: int, size: float, h: float, layer) -> int:
         return f_ball
     entities, entity_dim, depth = layer
     field = gmsh.model.mesh.field
-    f_dist = field.add("Distance")
-    field.setNumbers(f_dist, {1: "CurvesList", 2: "FacesList"}[entity_dim], list(entities))
     # Distances are to sample points: 100 per curve put them 8 mm apart on a 0.8 m end.
-    field.setNumber(f_dist, "NumPointsPerCurve", 100)
-    f_thr = field.add("Threshold")
-    field.setNumber(f_thr, "InField", f_dist)
-    for key, val in (("SizeMin", size), ("SizeMax", h), ("DistMin", depth),
-                     ("DistMax", depth + 2.0 * (h - size))):
-        field.setNumber(f_thr, key, val)
+    f_thr = _threshold(entities, entity_dim, size, h, depth, depth + 2.0 * (h - size), 100)
     f_max = field.add("Max")
     field.setNumbers(f_max, "FieldsList", [f_ball, f_thr])
     return f_max
