@@ -347,7 +347,7 @@ if not args.stage1_only and not args.no_paraview:
 # The crushed patch's contact mesh is refined with the rest; in 3D its contact zone then
 # outgrows the dense operators, and the finer meshes hold it through the factor of the
 # iteration matrix (`--contact-operator factor`, the same answer to rounding). In 3D the
-# study takes about 7 minutes and 3.6 GB here; `--mesh-study-contact kept` keeps the patch
+# study takes about 7 minutes and 3.7 GB here; `--mesh-study-contact kept` keeps the patch
 # at its size and refines the rest, leaving out the patch's error.
 
 # %%

@@ -94,8 +94,8 @@ def mesh_uniform(dim: int, h: float) -> None:
 
 def mesh_with_balls(dim: int, h: float, balls=(), layer=None) -> None:
     """Mesh the current model's ``dim``-entities with elements of size ``h``, capped inside
-    each ball ``(size, x, y, z, radius, thickness)`` as in :func:`size_field` (``layer``
-    too); no ball: as :func:`mesh_uniform`."""
+    each ball ``(size, x, y, z, radius)`` as in :func:`size_field` (``layer`` too); no ball:
+    as :func:`mesh_uniform`."""
     if not balls:
         return mesh_uniform(dim, h)
     _background([_layered(_ball(*b, h), b[0], h, layer) for b in balls])
@@ -121,12 +121,12 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
     """Background mesh size (m): h_near within dist_near of the ``dim``-entities (curves or
     surfaces), growing linearly to h_far at dist_far. ``boxes``: extra caps
     ``(size, x0, y0, z0, x1, y1, z1)``; inside such a box the size never exceeds ``size``.
-    ``balls``: caps ``(size, x, y, z, radius, thickness)``, the size inside the ball of that
-    radius, blending to the rest over ``thickness``; ``balls_only_in``: volume tags to which
-    the balls are restricted (with their faces, curves and points: gmsh 4.11 applies a
-    restriction to the listed entities only). ``layer`` = (entities, entity_dim, depth_m):
-    a ball's size holds only within ``depth_m`` of those entities (curves or surfaces), and
-    grows beyond at the rate 1/2 of the ball's blend (a crushed patch needs fine elements
+    ``balls``: caps ``(size, x, y, z, radius)``, the size inside the ball of that radius,
+    growing beyond it at the rate 1/2 until the rest is smaller; ``balls_only_in``: volume
+    tags to which the balls are restricted (with their faces, curves and points: gmsh 4.11
+    applies a restriction to the listed entities only). ``layer`` = (entities, entity_dim,
+    depth_m): a ball's size holds only within ``depth_m`` of those entities (curves or
+    surfaces), and grows beyond at the rate 1/2 too (a crushed patch needs fine elements
     along the end it lies on, not deep behind it). Sizes from points and curvature are
     switched off."""
     field = gmsh.model.mesh.field
@@ -139,6 +139,7 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
         field.setNumber(f_box, "VOut", h_far)
         fields.append(f_box)
     for ball in balls:
+        # Growing to h_far, the ball leaves the near field in charge beyond it (the Min below).
         f_ball = _layered(_ball(*ball, h_far), ball[0], h_far, layer)
         if balls_only_in:
             f_ball = _restricted(f_ball, balls_only_in)
@@ -162,12 +163,15 @@ def _threshold(entities, dim: int, size_min: float, size_max: float, dist_min: f
     return f_thr
 
 
-def _ball(size, x, y, z, radius, thickness, v_out) -> int:
-    """A Ball field: ``size`` inside the ball, blending to ``v_out`` over ``thickness``."""
+def _ball(size, x, y, z, radius, v_out) -> int:
+    """A Ball field: ``size`` inside the ball, growing to ``v_out`` at the rate 1/2 (over
+    2(v_out − size)) beyond it, as well-shaped grading needs: a blend over a fixed thickness
+    grows at a rate set by v_out (up to 8 from a crushed patch's 12.5 mm to a far field's
+    3 m)."""
     field = gmsh.model.mesh.field
     f = field.add("Ball")
     for key, val in (("XCenter", x), ("YCenter", y), ("ZCenter", z), ("Radius", radius),
-                     ("Thickness", thickness), ("VIn", size), ("VOut", v_out)):
+                     ("Thickness", 2.0 * (v_out - size)), ("VIn", size), ("VOut", v_out)):
         field.setNumber(f, key, val)
     return f
 

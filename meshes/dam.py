@@ -91,22 +91,15 @@ def _contact_layer(s, front, dim):
 def _contact_ball(s) -> tuple:
     """The size cap around the first-contact point (scenario ``mesh_size_contact_m``), where
     a crushing end's patch must be resolved: a ball of radius ``contact_zone_m`` about the
-    point halfway between the log's front point and the face, blending to h_impact over
-    a growth of 1/2."""
+    point halfway between the log's front point and the face, growing beyond it at the rate
+    1/2."""
     if s.h_contact_m >= s.h_impact_m:
         return ()
     front = np.asarray(s.log_front_point, float)
     centre = front.copy()
     centre[0] = 0.5 * front[0]
     x, y, z = (centre[0], centre[1], 0.0) if s.dim == 2 else tuple(centre)
-    return (ball_cap(s.h_contact_m, (x, y, z), s.contact_zone_m, s.h_impact_m),)
-
-
-def ball_cap(size, centre, radius, h) -> tuple:
-    """A ball cap of _gmsh.size_field: ``size`` within ``radius`` of ``centre`` (x, y, z),
-    blending to the surrounding ``h`` over 2(h − size), a growth rate of 1/2."""
-    x, y, z = (float(v) for v in centre)
-    return (size, x, y, z, radius, 2.0 * (h - size))
+    return ((float(s.h_contact_m), float(x), float(y), float(z), float(s.contact_zone_m)),)
 
 
 def _model_2d(s, info):
@@ -396,7 +389,7 @@ def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2, ball=None):
     ``log_front``) at x = +L/2, shaped by ``end`` (a :class:`~.log_end.LogEnd`; None: flat);
     elements of size ``h_m``, and of ``size`` within ``zone`` of the point (a, b) (3D:
     (a, b, 0)) when ``ball`` = (a, b, size, zone) is given: the crushed patch's refinement
-    (blending to ``h_m`` over 2(h_m − size), as the whole mesh's contact ball); with a fifth
+    (growing beyond it at the rate 1/2, as the whole mesh's contact ball); with a fifth
     entry ``layer``, only within ``layer`` (m) of the front end, growing behind it at the
     same rate (the scenario's ``contact_layer_m``). In 2D a
     plane-strain slab ``length_m`` × ``diameter_m`` (facets ``log_front``, ``log_back``,
@@ -410,7 +403,7 @@ def build_log(comm, length_m, diameter_m, h_m, end=None, dim=2, ball=None):
     balls, layer = (), None
     if ball is not None:
         a, b, size, zone = (float(v) for v in ball[:4])
-        balls = (ball_cap(size, (a, b, 0.0), zone, h),)
+        balls = ((size, a, b, 0.0, zone),)
         layer = float(ball[4]) if len(ball) > 4 else None
     if dim == 3:
         from .dam_apart_3d import build_log_3d
