@@ -86,6 +86,22 @@ void ImpactContact::find_blocks()
     if (reach_below[k] < k && reach_above[k] >= k)
       blocks_.push_back(k);
   blocks_.push_back(n);
+  symmetric_.assign(blocks_.size() - 1, false);
+  for (std::size_t b = 0; b + 1 < blocks_.size(); ++b)
+  {
+    const Eigen::Index a = blocks_[b], s = blocks_[b + 1] - a;
+    const auto block = F_.block(a, a, s, s);
+    const double tol = 1e-12 * block.cwiseAbs().maxCoeff();
+    bool sym = true;
+    for (Eigen::Index j = 0; j < s && sym; ++j)
+      for (Eigen::Index i = j + 1; i < s; ++i)
+        if (std::abs(block(i, j) - block(j, i)) > tol)
+        {
+          sym = false;
+          break;
+        }
+    symmetric_[b] = sym;
+  }
 }
 
 Vector ImpactContact::product(const Vector& x) const
@@ -107,6 +123,10 @@ Vector ImpactContact::product(const Vector& x) const
     if (2 * static_cast<Eigen::Index>(nonzero.size()) < s)
       for (Eigen::Index j : nonzero)
         y.segment(a, s).noalias() += x[j] * F_.col(j).segment(a, s);
+    else if (symmetric_[b])
+      // The product streams the block from memory: its lower triangle is half the bytes.
+      y.segment(a, s).noalias()
+          = F_.block(a, a, s, s).selfadjointView<Eigen::Lower>() * x.segment(a, s);
     else
       y.segment(a, s).noalias() = F_.block(a, a, s, s) * x.segment(a, s);
   }

@@ -301,7 +301,8 @@ TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
   // Two bodies condensed apart, three contact nodes each (DOFs 0–5 and 6–11), three pairs
   // from the first onto the second, so B reads every DOF: F̂ = diag(F₁, F₂), and the
   // products go by its two blocks. They must equal the whole products F̂ b and F̂ (b + r)
-  // to round-off, with a body at rest (its part of b zero) and a coupling entry (one block).
+  // to round-off, with a body at rest (its part of b zero), a coupling entry (one block)
+  // and a block that is not symmetric (multiplied whole, not by its lower triangle).
   const int n = 12;
   Matrix F = Matrix::Zero(n, n);
   for (int i = 0; i < n; ++i)
@@ -322,11 +323,13 @@ TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
   }
   for (int k = 0; k < 3; ++k)
     v[2 * k] = -0.5; // the first body's nodes approach the second's
-  auto check = [&](const Matrix& Fh, const Vector& load, int blocks, int closed = 3)
+  auto check = [&](const Matrix& Fh, const Vector& load, int blocks, int closed = 3,
+                   int symmetric = -1)
   {
     ImpactContact c(2, Fh, X, pairs, mu, 0.0, 1e-3, 0.5, {});
     ImpactContact ref(2, Fh, X, pairs, mu, 0.0, 1e-3, 0.5, {});
     EXPECT_EQ(c.diagonal_blocks(), blocks);
+    EXPECT_EQ(c.symmetric_blocks(), symmetric < 0 ? blocks : symmetric);
     const ImpactStep s = c.step_condensed(u, v, load);
     const Vector dv = Fh * load;
     const ImpactStep t = ref.step(u, v, v + dv);
@@ -342,6 +345,9 @@ TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
   Matrix coupled = F;
   coupled(1, 7) = coupled(7, 1) = 1e-3;
   check(coupled, b, 1);
+  Matrix skewed = F;
+  skewed(7, 6) += 0.05; // the second block loses its symmetry, the first keeps it
+  check(skewed, b, 2, 3, 1);
   // One pair closing: its reaction has 2 of each block's 6 DOFs, read by those columns.
   v[2] = v[4] = 0.5;
   check(F, b, 2, 1);

@@ -24,6 +24,7 @@
 #include "flexcontact/pairs.hpp"
 #include "flexcontact/problem.hpp"
 
+#include <algorithm>
 #include <Eigen/Sparse>
 #include <vector>
 
@@ -167,6 +168,10 @@ public:
   const Matrix& flexibility() const { return F_; } ///< F̂, constrained zeroed (dense path only)
   /// @brief Dense path: how many diagonal blocks F̂'s products go by (1: F̂ whole).
   int diagonal_blocks() const { return blocks_.empty() ? 0 : static_cast<int>(blocks_.size()) - 1; }
+  /// @brief Dense path: how many of those blocks are symmetric (to 1e-12 of their largest
+  /// entry), whose whole products read their lower triangle only.
+  int symmetric_blocks() const
+  { return static_cast<int>(std::count(symmetric_.begin(), symmetric_.end(), true)); }
   const std::vector<ContactPair>& contact_pairs() const { return pairs_; }
   const Vector& mu() const { return mu_; }
   double restitution() const { return e_; }
@@ -193,7 +198,8 @@ private:
   void fetch(const std::vector<int>& pairs);
   /// @brief Dense path: the contact DOFs B reads and F̂'s rows there (step_condensed).
   void keep_read_rows();
-  /// @brief Dense path: F̂'s diagonal blocks (blocks_), where no entry couples them.
+  /// @brief Dense path: F̂'s diagonal blocks (blocks_), where no entry couples them, and
+  /// which of them are symmetric (symmetric_).
   void find_blocks();
   /// @brief Dense path: F̂ x by F̂'s diagonal blocks, a block whose part of x is zero
   /// skipped, and one where x is mostly zero (a contact reaction) read by its nonzero
@@ -219,6 +225,10 @@ private:
   /// condensed apart (a log and a dam) give one block each, and a product by the blocks
   /// reads their entries only (half of F̂'s for two equal bodies).
   std::vector<Eigen::Index> blocks_;
+  /// Dense path: per block, whether it is symmetric. F̂ is the inverse of a symmetric
+  /// iteration matrix, but only to round-off, and a caller may hand any F̂: a block that is
+  /// not symmetric is multiplied whole.
+  std::vector<bool> symmetric_;
   Vector cap_;                     ///< force caps per pair, empty: no crushing
   Vector crush_node_;              ///< crush depth δ per contact node [m]
   Vector last_P_;                  ///< warm start
