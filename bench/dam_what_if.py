@@ -9,9 +9,11 @@ the time to load the model and to answer (from the command's own --json), the co
 (bench/dam_what_if_3d.json with ``--dim 3``). ``--main-job`` prepares
 ``examples/dam_model_main_job.toml`` instead, the 3D block at the main job's mesh with its
 crushing end, and asks the main job's own scenario (bench/dam_what_if_main_job.json), so
-that its outputs can be set beside the main job's.
+that its outputs can be set beside the main job's. ``--ab-saved-logs`` also times, run
+for run alternated with the model, the same model without its logs (the dam's files only,
+the log then meshed and factored by each what-if), and records the ratio pair by pair.
 
-    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3 | --main-job]
+    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3 | --main-job] [--ab-saved-logs]
 """
 import argparse
 import json
@@ -29,6 +31,8 @@ ap.add_argument("--runs", type=int, default=5)
 ap.add_argument("--dim", type=int, choices=(2, 3), default=2)
 ap.add_argument("--main-job", action="store_true",
                 help="the 3D block at the main job's mesh, crushing end, main job's scenario")
+ap.add_argument("--ab-saved-logs", action="store_true",
+                help="alternate each run with the same model stripped of its logs")
 ap.add_argument("--out", default=None)
 args = ap.parse_args()
 if args.main_job:
@@ -55,18 +59,46 @@ with tempfile.TemporaryDirectory() as tmp:
                     str(ROOT / CONFIG), "--out", str(model)],
                    check=True, cwd=ROOT, capture_output=True)
     prepare_s = time.perf_counter() - t0
-    runs = []
-    for _ in range(args.runs):
+    size = sum(p.stat().st_size for p in model.iterdir())
+    bare = None
+    if args.ab_saved_logs:
+        # The same dam files, no log: a valid model whose what-if builds its log.
+        bare = Path(tmp) / "model_without_logs"
+        bare.mkdir()
+        manifest = json.loads((model / "manifest.json").read_text())
+        log_files = {f for e in manifest["logs"]
+                     for f in [e.get("arrays"), *e.get("factor", {}).get("files", {})] if f}
+        for p in model.iterdir():
+            if p.name not in log_files and p.name != "manifest.json":
+                os.link(p, bare / p.name)
+        manifest["files"] = {k: v for k, v in manifest["files"].items() if k not in log_files}
+        if any(e.get("arrays") is None for e in manifest["logs"]):
+            sys.exit("--ab-saved-logs: a log held dense sits in arrays.npz; this compares "
+                     "large logs only")
+        manifest["logs"] = []
+        (bare / "manifest.json").write_text(json.dumps(manifest))
+
+    def what_if(path):
         t0 = time.perf_counter()
-        r = subprocess.run([sys.executable, "-m", "flexcontact", "dam", "what-if", str(model),
+        r = subprocess.run([sys.executable, "-m", "flexcontact", "dam", "what-if", str(path),
                             *ASK, "--json"], check=True, cwd=ROOT, capture_output=True,
                            text=True)
         wall = time.perf_counter() - t0
         out = json.loads(r.stdout)
-        runs.append({"command_s": wall, **{f"{k}_s": v for k, v in out["seconds"].items()},
-                     "counts": out["counts"]})
-        outputs = out["outputs"]
-    size = sum(p.stat().st_size for p in model.iterdir())
+        return {"command_s": wall, **{f"{k}_s": v for k, v in out["seconds"].items()},
+                "counts": out["counts"]}, out["outputs"]
+
+    runs, runs_bare = [], []
+    for _ in range(args.runs):
+        run, outputs = what_if(model)
+        runs.append(run)
+        if bare is not None:
+            run, bare_outputs = what_if(bare)
+            runs_bare.append(run)
+            timing = {"evaluate_s"}  # the evaluator's own clock, the only output that may differ
+            if ({k: v for k, v in bare_outputs.items() if k not in timing}
+                    != {k: v for k, v in outputs.items() if k not in timing}):
+                sys.exit("--ab-saved-logs: the answers differ with and without the saved log")
 result = {
     "what": ("dam what-if from a saved model, "
              + ("3D block at the main job's mesh, crushing end" if args.main_job
@@ -81,5 +113,12 @@ result = {
     "median_s": {k: statistics.median(r[k] for r in runs)
                  for k in ("command_s", "load_s", "evaluate_s")},
     "load_average_1min": os.getloadavg()[0], "machine": machine()}
+if runs_bare:
+    result["runs_without_saved_logs"] = runs_bare
+    result["with_over_without_saved_logs"] = {
+        k: statistics.median(a[k] / b[k] for a, b in zip(runs, runs_bare))
+        for k in ("command_s", "evaluate_s")}
 Path(args.out).write_text(json.dumps(result, indent=1))
 print(json.dumps(result["median_s"]), f"prepare {prepare_s:.1f} s, model {size / 1e6:.1f} MB")
+if runs_bare:
+    print("with / without the saved logs:", json.dumps(result["with_over_without_saved_logs"]))

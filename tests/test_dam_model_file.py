@@ -166,3 +166,43 @@ def test_a_3d_model_answers_in_a_new_process_as_the_factoring_evaluator(tmp_path
     assert c["back_substitutions"]["dam_stage2"] == own.counts()["back_substitutions"]["dam_stage2"]
     r = cli("what-if", path, "--log-across-m", 13.0)
     assert r.returncode == 2 and "face patch" in r.stderr, r.stderr
+
+
+BASE_FINE_LOG = DamScenario(mesh_size_far_m=6.0, mesh_size_impact_m=0.4,
+                            mesh_size_contact_m=0.0125, contact_zone_m=0.35,
+                            log_end_crushes=True)
+
+
+def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
+    """A log above the dense limit (its crushed patch refined: 1,980 DOFs) is kept as its
+    own arrays and MUMPS's Schur factor: a what-if in a new process restores it instead of
+    meshing and factoring it, and answers as the evaluator that factored it (1e-10). A model
+    whose log factor file is gone is refused naming the file."""
+    dt = sweep_time_step_s([BASE_FINE_LOG])
+    levels = (BASE_FINE_LOG.water_level_m,) * 2
+    path = tmp_path / "dam"
+    manifest = model_file.prepare(BASE_FINE_LOG, dt, levels, path, progress=lambda *a: None,
+                                  logs=[BASE_FINE_LOG])
+    (entry,) = manifest["logs"]
+    assert entry["factor"]["kind"] == "schur" and entry["arrays"] in manifest["files"]
+    asked = {"log_speed_m_s": 3.0, "log_pitch_deg": 12.0}
+    r = cli("what-if", path, *[a for k, v in asked.items()
+                               for a in ("--" + k.replace("_", "-"), v)], "--json")
+    assert r.returncode == 0, r.stderr
+    got = json.loads(r.stdout)
+    own = ScenarioEvaluator(BASE_FINE_LOG, dt, levels, MPI.COMM_SELF)
+    ref = own.evaluate(BASE_FINE_LOG.replace(**asked))
+    assert own.logs.get(BASE_FINE_LOG).factor_kind == "mumps_schur"
+    for key in OUTPUTS:
+        assert got["outputs"][key] == pytest.approx(ref[key], rel=1e-10), key
+    c = got["counts"]
+    assert c["factorizations"]["log"] == 0 and c["restorations"]["log"] == 1
+    # A scenario of another log reads none of the large log's files.
+    ev = model_file.load(path)
+    ev.evaluate(BASE_FINE_LOG.replace(log_length_m=8.0))
+    assert ev.counts()["restorations"].get("log", 0) == 0
+    assert ev.counts()["factorizations"]["log"] == 1
+    lost = next(n for n in entry["factor"]["files"] if n.endswith(".mumps"))
+    (path / lost).unlink()
+    with pytest.raises(SavedFileError, match=f"{lost}: missing"):
+        model_file.load(path)

@@ -184,13 +184,15 @@ class LogModel:
     :class:`~flexcontact.meshes.log_end.LogEnd` (None: flat); ``dim``: 2 or 3 (that of
     ``mesh`` when given). ``mass_kg_per_m``: the log's mass with its added mass (kg/m in
     2D, kg in 3D). ``factor_kind``: "dense" (a log of at most dense_factor.DENSE_LIMIT
-    DOFs, held as dense blocks) or "mumps_schur". Serial.
+    DOFs, held as dense blocks) or "mumps_schur". ``factor``: a factor restored from a
+    model file instead of factoring (a DenseFactor, or MUMPS's Schur factor with its
+    flexibility ``W_front`` on the front DOFs). Serial.
     """
 
     def __init__(self, length_m: float, diameter_m: float, rho_effective_kg_m3: float,
                  E: float, nu: float, dt_s: float, h_m: float = None, theta: float = 0.5,
                  comm=MPI.COMM_SELF, mesh: "LogMesh" = None, end=None, dim: int = 2,
-                 factor: "DenseFactor" = None):
+                 factor=None, W_front: Optional[np.ndarray] = None):
         if comm.size != 1:
             raise InputError(f"comm of size {comm.size}: LogModel is serial (one rank)")
         setup.check_scheme(dt_s, 0.0, theta, "consistent", (0.0, 0.0))
@@ -210,7 +212,7 @@ class LogModel:
         self._factor()
         self.front, self.front_dofs = self.mesh.front, self.mesh.front_dofs
         n = self.W_hat.getSize()[0]
-        if factor is not None:
+        if isinstance(factor, DenseFactor):
             # Restored from a model file (dam/model_file.py): nothing factored.
             if factor.n != n or not np.array_equal(factor.c, self.front_dofs):
                 raise InputError(f"a saved log factor of {factor.n} DOFs does not fit this "
@@ -218,6 +220,17 @@ class LogModel:
             self.factor, self.W_front = factor, factor.W
             self.restorations += 1
             self.factor_kind = "dense"
+        elif factor is not None:
+            # MUMPS's Schur factor restored from a model file with its F* (W_front).
+            c = self.front_dofs.size
+            if factor.size != n or factor.n_schur != c or W_front is None \
+                    or np.shape(W_front) != (c, c):
+                raise InputError(f"a saved log factor of {factor.size} DOFs and "
+                                 f"{factor.n_schur} front DOFs does not fit this log of {n} "
+                                 f"DOFs and {c} front DOFs")
+            self.factor, self.W_front = factor, np.asarray(W_front)
+            self.restorations += 1
+            self.factor_kind = "mumps_schur"
         elif DenseFactor.worth_it(n):
             # A log of a few hundred DOFs: dense blocks beat the sparse solve's overhead.
             self.factor = DenseFactor(self.W_hat, self.front_dofs)

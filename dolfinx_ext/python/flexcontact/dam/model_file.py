@@ -7,8 +7,11 @@ The model is one directory, written atomically (complete or absent):
   the time step, the water-level range, the face strip) and their SHA-256, the hash of the
   dam's mesh, and the size and SHA-256 of every other file;
 * ``arrays.npz``: the face's condensed flexibility W_face, the base section's response
-  functions (dam/response.py), the face compliance of the re-contact bound, and the static
-  displacement of each water level it was asked for;
+  functions (dam/response.py), the face compliance of the re-contact bound, the static
+  displacement of each water level it was asked for, and the config's logs held dense
+  (dense_factor.DENSE_LIMIT);
+* a larger log of the config: ``logN_arrays.npz`` (its K, M₁, front and W_front) and
+  MUMPS's files of its Schur factor on the front, read when a scenario first asks for it;
 * MUMPS's own files of the two factors, K (stage 1: another water level in the range is one
   back-substitution) and Ŵ (stage 2, with its Schur complement on the face, so that a
   restored dam condenses and expands as the one that factored it), written and checked by
@@ -38,9 +41,13 @@ from .. import saved_factor
 from ..split_factor import SplitFactor
 from ..errors import SavedFileError
 
-MODEL_FORMAT = 2
-"""The model directory's format: a model of another format is refused (2: a factor may be
-held in arrays.npz, "kind": "split")."""
+MODEL_FORMAT = 3
+"""The model directory's format (2: a factor may be held in arrays.npz, "kind": "split";
+3: a large log kept as its own arrays file and MUMPS factor)."""
+
+READABLE_FORMATS = (2, 3)
+"""Formats this flexcontact loads (a format-2 model holds no large log); any other is
+refused."""
 
 SPLIT = "split"
 """The manifest's "kind" of a factor kept in arrays.npz (split_factor.SplitFactor)."""
@@ -71,7 +78,8 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
     now (default: twice the steps of the base scenario's run; a longer run extends them on
     load, from the saved adjoint state, counted); ``strip_m``, ``patch_y_m``: the face
     region condensed (default: DamModel's); ``logs``: scenarios whose log models are kept
-    too (one per distinct log; logs held dense only, dense_factor.DENSE_LIMIT). Returns the
+    too (one per distinct log: dense in ``arrays.npz``, or a large log as its own arrays
+    file and MUMPS's Schur factor files). Returns the
     manifest."""
     from .dam_model import DamModel
     path = Path(path)
@@ -105,7 +113,7 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
             else:
                 factors[name] = saved_factor.save_factor(f, tmp, name)
         arrays.update(responses.saved())
-        kept_logs = _log_arrays(base, dam, logs, arrays)
+        kept_logs = _log_arrays(base, dam, logs, arrays, tmp)
         for i, (z, st) in enumerate(statics.items()):
             arrays[f"static_u_{i}"] = st.u.x.array
         np.savez(tmp / "arrays.npz", **arrays)
@@ -120,7 +128,8 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
                                  "section_foundation": statics[z].section_foundation.__dict__}
                         for i, z in enumerate(levels)},
             "factors": factors, "counts": dam.counts(), "logs": kept_logs,
-            "files": {"arrays.npz": _file_entry(tmp / "arrays.npz")}}
+            "files": {name: _file_entry(tmp / name) for name in
+                      ["arrays.npz", *(e["arrays"] for e in kept_logs if "arrays" in e)]}}
         (tmp / "manifest.json").write_text(json.dumps(manifest, indent=1, default=_plain))
         old = path.parent / f".{path.name}.old-{os.getpid()}"
         if path.exists():
@@ -160,9 +169,10 @@ def read_manifest(path) -> dict:
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise SavedFileError(f"{mpath}: not readable JSON ({e}): a truncated or altered "
                              "model") from None
-    if manifest.get("format") != MODEL_FORMAT:
+    if manifest.get("format") not in READABLE_FORMATS:
         raise SavedFileError(f"{path}: model format {manifest.get('format')!r}; this "
-                             f"flexcontact reads format {MODEL_FORMAT}: prepare it again")
+                             f"flexcontact reads formats {READABLE_FORMATS[0]} to "
+                             f"{READABLE_FORMATS[-1]}: prepare it again")
     if inputs_hash(manifest["inputs"]) != manifest.get("inputs_sha256"):
         raise SavedFileError(f"{mpath}: its inputs do not match their SHA-256 (the manifest "
                              "was edited)")
@@ -177,7 +187,8 @@ def read_manifest(path) -> dict:
         if got["sha256"] != want["sha256"]:
             raise SavedFileError(f"{p}: its SHA-256 differs from the saved one (the file was "
                                  "altered)")
-    for entry in manifest["factors"].values():
+    for entry in [*manifest["factors"].values(),
+                  *(e["factor"] for e in manifest.get("logs", []) if "factor" in e)]:
         if entry.get("kind") != SPLIT:  # a split factor's arrays were checked above
             saved_factor.check_factor_files(path, entry)
     return manifest
@@ -243,10 +254,28 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
     for entry in manifest.get("logs", []):
         from ..dense_factor import DenseFactor
         from .log_model import LogMesh
-        p = entry["prefix"]
-        ev.logs.restore(DamScenario.from_dict(entry["scenario"]),
-                        LogMesh.from_arrays(arrays, p), DenseFactor.from_arrays(arrays, p + "f_"))
+        p, s = entry["prefix"], DamScenario.from_dict(entry["scenario"])
+        if "factor" in entry:
+            ball = entry.get("ball")
+            ev.logs.restore_later(s, None if ball is None else tuple(ball),
+                                  lambda entry=entry: _large_log(path, entry))
+        else:
+            ev.logs.restore(s, LogMesh.from_arrays(arrays, p),
+                            DenseFactor.from_arrays(arrays, p + "f_"))
     return ev
+
+
+def _large_log(path: Path, entry: dict):
+    """(LogMesh, restored Schur factor, W_front) of a log that the model keeps factored by
+    MUMPS: its own arrays file and factor files, read when a scenario first asks for it."""
+    from .log_model import LogMesh
+    p = entry["prefix"]
+    with np.load(path / entry["arrays"]) as z:
+        arrays = {k: z[k] for k in z.files}
+    mesh = LogMesh.from_arrays(arrays, p)
+    W_front = arrays[p + "W_front"]
+    factor = saved_factor.restore_factor(path, entry["factor"], mesh.front_dofs, W_front)
+    return mesh, factor, W_front
 
 
 MAX_LOGS = 16
@@ -264,9 +293,11 @@ def logs_of(base, scenarios) -> list:
     return list(distinct.values()) if len(distinct) <= MAX_LOGS else [base]
 
 
-def _log_arrays(base, dam, logs, arrays: dict) -> list:
-    """Build the log model of each distinct log among ``logs`` at the dam's time step, put
-    its arrays in ``arrays`` and return the manifest's entries."""
+def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> list:
+    """Build the log model of each distinct log among ``logs`` at the dam's time step and
+    return the manifest's entries. A log held dense goes into ``arrays``; a log factored by
+    MUMPS (its Schur factor on the front) gets its own arrays file in ``folder`` (its K, M₁,
+    front and W_front) and MUMPS's factor files, read only when a scenario asks for it."""
     from .reuse import LogCache, log_key
     cache = LogCache(dam.dt, base.h_impact_m, dam.comm, dam.theta)
     entries = []
@@ -274,12 +305,18 @@ def _log_arrays(base, dam, logs, arrays: dict) -> list:
         if log_key(s) in cache.models:
             continue  # one entry per distinct log
         log = cache.get(s)
-        if log.factor_kind != "dense":
-            continue  # a large log is built on the spot when asked
         p = f"log{len(entries)}_"
-        arrays.update(log.mesh.arrays(p))
-        arrays.update(log.factor.arrays(p + "f_"))
-        entries.append({"prefix": p, "scenario": s.as_dict()})
+        entry = {"prefix": p, "scenario": s.as_dict()}
+        if log.factor_kind == "dense":
+            arrays.update(log.mesh.arrays(p))
+            arrays.update(log.factor.arrays(p + "f_"))
+        else:
+            entry["arrays"] = p + "arrays.npz"
+            np.savez(folder / entry["arrays"], **log.mesh.arrays(p),
+                     **{p + "W_front": log.W_front})
+            entry["factor"] = saved_factor.save_factor(log.factor, folder, p + "factor")
+            entry["ball"] = None if log.mesh.ball is None else list(log.mesh.ball)
+        entries.append(entry)
     return entries
 
 
