@@ -41,7 +41,7 @@ def cli(*args):
 
 def test_what_if_in_a_new_process_equals_the_factoring_evaluator(model):
     path, manifest = model
-    assert manifest["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1}
+    assert manifest["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 0}
     # The 2D section's Ŵ is kept as the split factor's arrays, K as MUMPS's files.
     assert manifest["factors"]["stage2"]["kind"] == model_file.SPLIT
     assert "kind" not in manifest["factors"]["stage1"]
@@ -185,6 +185,7 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
                                   logs=[BASE_FINE_LOG])
     (entry,) = manifest["logs"]
     assert entry["factor"]["kind"] == "schur" and entry["arrays"] in manifest["files"]
+    assert manifest["counts"]["factorizations"]["log"] == 1  # counted where it was made
     asked = {"log_speed_m_s": 3.0, "log_pitch_deg": 12.0}
     r = cli("what-if", path, *[a for k, v in asked.items()
                                for a in ("--" + k.replace("_", "-"), v)], "--json")

@@ -444,7 +444,8 @@ def test_reuse_sweep_factors_the_dam_twice_and_the_log_once(tmp_path):
     assert s["counts"]["restorations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 1,
                                            "total": 3}, s["counts"]  # K, K_eff, the log
     assert s["dam_model"]["prepared_this_run"]
-    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1}
+    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1,
+                                                          "log": 1}
     for o, w in own["worst"].items():
         assert s["worst"][o]["id"] == w["id"]
         assert s["worst"][o]["value"] == pytest.approx(w["value"], rel=1e-10)
@@ -539,7 +540,8 @@ def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):
     assert s["counts"]["factorizations"]["total"] == 0, s["counts"]
     assert s["counts"]["restorations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 1,
                                            "total": 3}, s["counts"]
-    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1}
+    assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1,
+                                                          "log": 1}
     c = s["convergence"]["peak_force_filtered_N_per_m"]
     assert c["evaluator_refined"] == "monolithic" and c["refine"] == 0
     fine = c["outputs_refined"]

@@ -113,7 +113,9 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
             else:
                 factors[name] = saved_factor.save_factor(f, tmp, name)
         arrays.update(responses.saved())
-        kept_logs = _log_arrays(base, dam, logs, arrays, tmp)
+        kept_logs, log_factorizations = _log_arrays(base, dam, logs, arrays, tmp)
+        counts = dam.counts()
+        counts["factorizations"]["log"] = log_factorizations
         for i, (z, st) in enumerate(statics.items()):
             arrays[f"static_u_{i}"] = st.u.x.array
         np.savez(tmp / "arrays.npz", **arrays)
@@ -127,7 +129,7 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
                                  "section": statics[z].section.__dict__,
                                  "section_foundation": statics[z].section_foundation.__dict__}
                         for i, z in enumerate(levels)},
-            "factors": factors, "counts": dam.counts(), "logs": kept_logs,
+            "factors": factors, "counts": counts, "logs": kept_logs,
             "files": {name: _file_entry(tmp / name) for name in
                       ["arrays.npz", *(e["arrays"] for e in kept_logs if "arrays" in e)]}}
         (tmp / "manifest.json").write_text(json.dumps(manifest, indent=1, default=_plain))
@@ -295,9 +297,10 @@ def logs_of(base, scenarios) -> list:
 
 def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> list:
     """Build the log model of each distinct log among ``logs`` at the dam's time step and
-    return the manifest's entries. A log held dense goes into ``arrays``; a log factored by
-    MUMPS (its Schur factor on the front) gets its own arrays file in ``folder`` (its K, M₁,
-    front and W_front) and MUMPS's factor files, read only when a scenario asks for it."""
+    return the manifest's entries and the factorizations this cost. A log held dense goes
+    into ``arrays``; a log factored by MUMPS (its Schur factor on the front) gets its own
+    arrays file in ``folder`` (its K, M₁, front and W_front) and MUMPS's factor files, read
+    only when a scenario asks for it."""
     from .reuse import LogCache, log_key
     cache = LogCache(dam.dt, base.h_impact_m, dam.comm, dam.theta)
     entries = []
@@ -317,7 +320,7 @@ def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> list:
             entry["factor"] = saved_factor.save_factor(log.factor, folder, p + "factor")
             entry["ball"] = None if log.mesh.ball is None else list(log.mesh.ball)
         entries.append(entry)
-    return entries
+    return entries, sum(m.factorizations for m in cache.models.values())
 
 
 def _section(d: dict) -> dict:

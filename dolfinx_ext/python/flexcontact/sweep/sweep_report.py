@@ -253,10 +253,12 @@ def _computation(s: dict) -> list:
         m = s["dam_model"]
         f = m["counts"]["factorizations"]
         L += ["", (f"The dam model `{m['path']}` was prepared by this run (factorizations of "
-                   f"the dam, once: {f}; not in the sums above) and every worker loaded it: "
+                   f"the dam and of the logs it keeps, once: {f}; not in the sums above) and "
+                   "every worker loaded it: "
                    if m["prepared_this_run"] else
                    f"Every worker loaded the dam model `{m['path']}`, prepared before: ")
-              + "the dam's factors are restored, not factored (row `restorations`)."]
+              + "the dam's factors and the kept logs' are restored, not factored (row "
+              "`restorations`)."]
         if "replaced" in m:
             L += ["", f"It replaced this sweep's earlier model, which no longer matched: "
                       f"{m['replaced']}"]
