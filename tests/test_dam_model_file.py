@@ -39,16 +39,21 @@ def cli(*args):
                           capture_output=True, text=True, cwd=ROOT, env=env, timeout=600)
 
 
+def what_if_json(path, asked: dict) -> dict:
+    """The --json answer of `dam what-if` in a new process, asked ``asked`` as options."""
+    r = cli("what-if", path, *[a for k, v in asked.items()
+                               for a in ("--" + k.replace("_", "-"), v)], "--json")
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout)
+
+
 def test_what_if_in_a_new_process_equals_the_factoring_evaluator(model):
     path, manifest = model
     assert manifest["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 0}
     # The 2D section's Ŵ is kept as the split factor's arrays, K as MUMPS's files.
     assert manifest["factors"]["stage2"]["kind"] == model_file.SPLIT
     assert "kind" not in manifest["factors"]["stage1"]
-    r = cli("what-if", path, *[a for k, v in ASKED.items()
-                               for a in ("--" + k.replace("_", "-"), v)], "--json")
-    assert r.returncode == 0, r.stderr
-    got = json.loads(r.stdout)
+    got = what_if_json(path, ASKED)
     ref = ScenarioEvaluator(BASE, DT, LEVELS, MPI.COMM_SELF).evaluate(BASE.replace(**ASKED))
     for key in OUTPUTS:
         assert got["outputs"][key] == pytest.approx(ref[key], rel=1e-10), key
@@ -150,10 +155,7 @@ def test_a_3d_model_answers_in_a_new_process_as_the_factoring_evaluator(tmp_path
     assert manifest["inputs"]["patch_y_m"][0] > 0.0
     assert manifest["factors"]["stage2"]["kind"] == "schur"  # MUMPS's files, split kept
     assert len(manifest["logs"]) == 1
-    r = cli("what-if", path, *[a for k, v in ASKED_3D.items()
-                               for a in ("--" + k.replace("_", "-"), v)], "--json")
-    assert r.returncode == 0, r.stderr
-    got = json.loads(r.stdout)
+    got = what_if_json(path, ASKED_3D)
     own = ScenarioEvaluator(BASE_3D, dt, levels, MPI.COMM_SELF)
     ref = own.evaluate(BASE_3D.replace(**ASKED_3D))
     for key in OUTPUTS:
@@ -187,10 +189,7 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
     assert entry["factor"]["kind"] == "schur" and entry["arrays"] in manifest["files"]
     assert manifest["counts"]["factorizations"]["log"] == 1  # counted where it was made
     asked = {"log_speed_m_s": 3.0, "log_pitch_deg": 12.0}
-    r = cli("what-if", path, *[a for k, v in asked.items()
-                               for a in ("--" + k.replace("_", "-"), v)], "--json")
-    assert r.returncode == 0, r.stderr
-    got = json.loads(r.stdout)
+    got = what_if_json(path, asked)
     own = ScenarioEvaluator(BASE_FINE_LOG, dt, levels, MPI.COMM_SELF)
     ref = own.evaluate(BASE_FINE_LOG.replace(**asked))
     assert own.logs.get(BASE_FINE_LOG).factor_kind == "mumps_schur"
