@@ -253,8 +253,8 @@ def _computation(s: dict) -> list:
         m = s["dam_model"]
         f = m["counts"]["factorizations"]
         L += ["", (f"The dam model `{m['path']}` was prepared by this run (factorizations of "
-                   f"the dam and of the logs it keeps, once: {f}; not in the sums above) and "
-                   "every worker loaded it: "
+                   f"the dam and of the logs it keeps, once: {_named_counts(f)}; not in the "
+                   "sums above) and every worker loaded it: "
                    if m["prepared_this_run"] else
                    f"Every worker loaded the dam model `{m['path']}`, prepared before: ")
               + "the dam's factors and the kept logs' are restored, not factored (row "
@@ -265,6 +265,12 @@ def _computation(s: dict) -> list:
     if "counts_driver_check" in s:
         d = s["counts_driver_check"]
         L += ["", "Not in these sums: the evaluator the driving process built to check every "
-              f"scenario before computing: factorizations {d['factorizations']}, "
-              f"back-substitutions {d['back_substitutions']}."]
+              "scenario before computing: factorizations "
+              f"{_named_counts(d['factorizations'])}; back-substitutions "
+              f"{_named_counts(d['back_substitutions'])}."]
     return L
+
+
+def _named_counts(counts: dict) -> str:
+    """Counts named as the table's columns: "dam_stage1 1, dam_stage2 1, log 3"."""
+    return ", ".join(f"{k} {v}" for k, v in counts.items())
