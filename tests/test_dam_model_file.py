@@ -202,6 +202,16 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
     ev.evaluate(BASE_FINE_LOG.replace(log_length_m=8.0))
     assert ev.counts()["restorations"].get("log", 0) == 0
     assert ev.counts()["factorizations"]["log"] == 1
+    # Its files are hashed when read, not at every load: an altered arrays file is named
+    # by the scenario that reads it, while another log's scenario still answers.
+    arrays = path / entry["arrays"]
+    data = bytearray(arrays.read_bytes())
+    data[-10] ^= 1
+    arrays.write_bytes(bytes(data))
+    ev = model_file.load(path)
+    ev.evaluate(BASE_FINE_LOG.replace(log_length_m=8.0))
+    with pytest.raises(SavedFileError, match=f"{entry['arrays']}: its SHA-256 differs"):
+        ev.evaluate(BASE_FINE_LOG.replace(**asked))
     lost = next(n for n in entry["factor"]["files"] if n.endswith(".mumps"))
     (path / lost).unlink()
     with pytest.raises(SavedFileError, match=f"{lost}: missing"):

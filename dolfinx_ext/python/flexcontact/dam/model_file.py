@@ -158,9 +158,13 @@ def _file_entry(p: Path) -> dict:
     return {"bytes": p.stat().st_size, "sha256": saved_factor.sha256(p)}
 
 
-def read_manifest(path) -> dict:
+def read_manifest(path, every_file: bool = False) -> dict:
     """The checked manifest of the model at ``path``: SavedFileError naming what is missing,
-    truncated, altered or of another format."""
+    truncated, altered or of another format. The files read only through a factor's
+    restoration or a large log's first use (MUMPS's factor files, ``logN_arrays.npz``) are
+    checked here for presence and size, and their SHA-256 when they are read: hashing them
+    here too read each of them twice. ``every_file``: hash those too (a sweep's check of its
+    model, once, before its workers load it)."""
     path = Path(path)
     mpath = path / "manifest.json"
     if not mpath.is_file():
@@ -178,22 +182,28 @@ def read_manifest(path) -> dict:
     if inputs_hash(manifest["inputs"]) != manifest.get("inputs_sha256"):
         raise SavedFileError(f"{mpath}: its inputs do not match their SHA-256 (the manifest "
                              "was edited)")
+    later = {e["arrays"] for e in manifest.get("logs", []) if "arrays" in e}
     for name, want in manifest["files"].items():
-        p = path / name
-        if not p.is_file():
-            raise SavedFileError(f"{p}: missing from the model")
-        got = _file_entry(p)
-        if got["bytes"] != want["bytes"]:
-            raise SavedFileError(f"{p}: {got['bytes']} bytes, {want['bytes']} were saved (a "
-                                 "truncated or replaced file)")
-        if got["sha256"] != want["sha256"]:
-            raise SavedFileError(f"{p}: its SHA-256 differs from the saved one (the file was "
-                                 "altered)")
+        check_file(path / name, want, contents=every_file or name not in later)
     for entry in [*manifest["factors"].values(),
                   *(e["factor"] for e in manifest.get("logs", []) if "factor" in e)]:
         if entry.get("kind") != SPLIT:  # a split factor's arrays were checked above
-            saved_factor.check_factor_files(path, entry)
+            saved_factor.check_factor_files(path, entry, contents=every_file)
     return manifest
+
+
+def check_file(p: Path, want: dict, contents: bool = True) -> None:
+    """SavedFileError if the model's file ``p`` is missing, or its size (and with
+    ``contents`` its SHA-256) differs from ``want``."""
+    if not p.is_file():
+        raise SavedFileError(f"{p}: missing from the model")
+    size = p.stat().st_size
+    if size != want["bytes"]:
+        raise SavedFileError(f"{p}: {size} bytes, {want['bytes']} were saved (a truncated or "
+                             "replaced file)")
+    if contents and saved_factor.sha256(p) != want["sha256"]:
+        raise SavedFileError(f"{p}: its SHA-256 differs from the saved one (the file was "
+                             "altered)")
 
 
 def check_inputs(manifest: dict, base=None, dt_s=None) -> None:
@@ -259,19 +269,22 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
         p, s = entry["prefix"], DamScenario.from_dict(entry["scenario"])
         if "factor" in entry:
             ball = entry.get("ball")
+            want = manifest["files"][entry["arrays"]]
             ev.logs.restore_later(s, None if ball is None else tuple(ball),
-                                  lambda entry=entry: _large_log(path, entry))
+                                  lambda entry=entry, want=want: _large_log(path, entry, want))
         else:
             ev.logs.restore(s, LogMesh.from_arrays(arrays, p),
                             DenseFactor.from_arrays(arrays, p + "f_"))
     return ev
 
 
-def _large_log(path: Path, entry: dict):
+def _large_log(path: Path, entry: dict, want: dict):
     """(LogMesh, restored Schur factor, W_front) of a log that the model keeps factored by
-    MUMPS: its own arrays file and factor files, read when a scenario first asks for it."""
+    MUMPS: its own arrays file (checked against ``want``, its manifest entry) and factor
+    files, read when a scenario first asks for it."""
     from .log_model import LogMesh
     p = entry["prefix"]
+    check_file(path / entry["arrays"], want)
     with np.load(path / entry["arrays"]) as z:
         arrays = {k: z[k] for k in z.files}
     mesh = LogMesh.from_arrays(arrays, p)

@@ -115,7 +115,7 @@ def _check_model(path: Path, base, dt: float) -> dict:
     """The manifest of the model at ``path`` if it is of this dam and time step; else
     SavedFileError or ConfigError naming what differs."""
     from ..dam import model_file
-    manifest = model_file.read_manifest(path)
+    manifest = model_file.read_manifest(path, every_file=True)
     model_file.check_inputs(manifest, base)
     saved_dt = manifest["inputs"]["dt_s"]
     if float(dt) != saved_dt:
