@@ -75,16 +75,22 @@ def check_factor_files(folder, entry: dict, contents: bool = True) -> None:
                              f"{entry.get('mumps_version')}, this build has MUMPS "
                              f"{_cpp.mumps_version}: factor it again")
     for name, want in entry["files"].items():
-        path = folder / name
-        if not path.is_file():
-            raise SavedFileError(f"{path}: missing (factor '{entry['name']}')")
-        size = path.stat().st_size
-        if size != want["bytes"]:
-            raise SavedFileError(f"{path}: {size} bytes, {want['bytes']} were saved (a "
-                                 "truncated or replaced file)")
-        if contents and sha256(path) != want["sha256"]:
-            raise SavedFileError(f"{path}: its SHA-256 differs from the saved one (the file "
-                                 "was altered)")
+        check_file(folder / name, want, contents, f" (factor '{entry['name']}')")
+
+
+def check_file(path: Path, want: dict, contents: bool = True, whose: str = "") -> None:
+    """SavedFileError if the saved file ``path`` is missing (``whose`` says what it
+    belongs to), or its size (and with ``contents`` its SHA-256) differs from ``want``
+    ({"bytes", "sha256"})."""
+    if not path.is_file():
+        raise SavedFileError(f"{path}: missing{whose}")
+    size = path.stat().st_size
+    if size != want["bytes"]:
+        raise SavedFileError(f"{path}: {size} bytes, {want['bytes']} were saved (a "
+                             "truncated or replaced file)")
+    if contents and sha256(path) != want["sha256"]:
+        raise SavedFileError(f"{path}: its SHA-256 differs from the saved one (the file "
+                             "was altered)")
 
 
 def restore_factor(folder, entry: dict, schur_dofs=None, flexibility=None):

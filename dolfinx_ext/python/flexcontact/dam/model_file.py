@@ -193,17 +193,7 @@ def read_manifest(path, every_file: bool = False) -> dict:
 
 
 def check_file(p: Path, want: dict, contents: bool = True) -> None:
-    """SavedFileError if the model's file ``p`` is missing, or its size (and with
-    ``contents`` its SHA-256) differs from ``want``."""
-    if not p.is_file():
-        raise SavedFileError(f"{p}: missing from the model")
-    size = p.stat().st_size
-    if size != want["bytes"]:
-        raise SavedFileError(f"{p}: {size} bytes, {want['bytes']} were saved (a truncated or "
-                             "replaced file)")
-    if contents and saved_factor.sha256(p) != want["sha256"]:
-        raise SavedFileError(f"{p}: its SHA-256 differs from the saved one (the file was "
-                             "altered)")
+    saved_factor.check_file(p, want, contents, " from the model")
 
 
 def check_inputs(manifest: dict, base=None, dt_s=None) -> None:
