@@ -298,7 +298,7 @@ def logs_of(base, scenarios) -> list:
     return list(distinct.values()) if len(distinct) <= MAX_LOGS else [base]
 
 
-def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> list:
+def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> tuple[list, int]:
     """Build the log model of each distinct log among ``logs`` at the dam's time step and
     return the manifest's entries and the factorizations this cost. A log held dense goes
     into ``arrays``; a log factored by MUMPS (its Schur factor on the front) gets its own
