@@ -117,7 +117,7 @@ def physical(dim: int, entities, tag: int, name: str):
 
 def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float,
                dist_far: float, points_per_curve: int = 20, boxes=(), balls=(),
-               balls_only_in=None, layer=None):
+               balls_only_in=None, layer=None, caps_in=()):
     """Background mesh size (m): h_near within dist_near of the ``dim``-entities (curves or
     surfaces), growing linearly to h_far at dist_far. ``boxes``: extra caps
     ``(size, x0, y0, z0, x1, y1, z1)``; inside such a box the size never exceeds ``size``.
@@ -127,8 +127,10 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
     applies a restriction to the listed entities only). ``layer`` = (entities, entity_dim,
     depth_m): a ball's size holds only within ``depth_m`` of those entities (curves or
     surfaces), and grows beyond at the rate 1/2 too (a crushed patch needs fine elements
-    along the end it lies on, not deep behind it). Sizes from points and curvature are
-    switched off."""
+    along the end it lies on, not deep behind it). ``caps_in``: caps ``(size, entity_dim,
+    tags)``, the size never exceeded in those surfaces (2) or volumes (3) and on their
+    closure, as a body meshed finer than the zone about it. Sizes from points and curvature
+    are switched off."""
     field = gmsh.model.mesh.field
     fields = [_threshold(entities, dim, h_near, h_far, dist_near, dist_far, points_per_curve)]
     for size, *box in boxes:
@@ -144,6 +146,10 @@ def size_field(entities, dim: int, h_near: float, h_far: float, dist_near: float
         if balls_only_in:
             f_ball = _restricted(f_ball, balls_only_in)
         fields.append(f_ball)
+    for size, entity_dim, tags in caps_in:
+        f_size = field.add("MathEval")
+        field.setString(f_size, "F", repr(float(size)))
+        fields.append(_restricted(f_size, tags, entity_dim))
     _background(fields)
 
 
@@ -204,18 +210,21 @@ def _background(fields: list) -> None:
         gmsh.option.setNumber(f"Mesh.{key}", 0)
 
 
-def _restricted(f_in: int, volumes) -> int:
-    """A Restrict field applying ``f_in`` in ``volumes`` and on their closure."""
+def _restricted(f_in: int, entities, dim: int = 3) -> int:
+    """A Restrict field applying ``f_in`` in the ``dim``-entities (volumes or surfaces) and
+    on their closure."""
     field = gmsh.model.mesh.field
-    vols = [(3, v) for v in volumes]
-    faces = gmsh.model.getBoundary(vols, combined=False, oriented=False)
-    curves = gmsh.model.getBoundary(faces, combined=False, oriented=False)
-    points = gmsh.model.getBoundary(vols, combined=False, oriented=False, recursive=True)
+    closure = {dim: [(dim, t) for t in entities]}
+    for d in range(dim, 1, -1):
+        closure[d - 1] = gmsh.model.getBoundary(closure[d], combined=False, oriented=False)
+    closure[0] = gmsh.model.getBoundary(closure[dim], combined=False, oriented=False,
+                                        recursive=True)
     f = field.add("Restrict")
     field.setNumber(f, "InField", f_in)
-    for key, dimtags in (("VolumesList", vols), ("SurfacesList", faces),
-                         ("CurvesList", curves), ("PointsList", points)):
-        field.setNumbers(f, key, sorted({abs(t) for _, t in dimtags}))
+    for d, key in ((3, "VolumesList"), (2, "SurfacesList"), (1, "CurvesList"),
+                   (0, "PointsList")):
+        if d in closure:
+            field.setNumbers(f, key, sorted({abs(t) for _, t in closure[d]}))
     return f
 
 

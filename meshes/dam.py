@@ -12,7 +12,8 @@ checks every dimension, see its docstring for the axes and the profile) and retu
   below the water and zero above, is integrated exactly.
 * Elements have the size ``scenario.h_impact_m`` on the log and within
   ``scenario.impact_zone_m`` of it (so also on the part of the upstream face the log can
-  hit), growing to ``scenario.h_far_m`` away from it.
+  hit), growing to ``scenario.h_far_m`` away from it; on the log ``scenario.h_log_m`` when
+  finer (``mesh_size_log_m``).
 """
 from __future__ import annotations
 
@@ -31,13 +32,14 @@ def build(comm, scenario):
     """Mesh ``scenario`` (a checked DamScenario) on ``comm``: 2D or 3D by ``scenario.dim``.
 
     ``info``: base_width_m, knee_elevation_m, water_level_m, tailwater_level_m, log_centre,
-    log_front_point, log_axis, h_far_m, h_impact_m.
+    log_front_point, log_axis, h_far_m, h_impact_m, h_log_m.
     """
     s = scenario
     info = dict(dim=s.dim, base_width_m=s.base_width_m, knee_elevation_m=s.knee_elevation_m,
                 water_level_m=s.water_level_m, tailwater_level_m=s.tailwater_level_m,
                 log_centre=s.log_centre.tolist(), log_front_point=s.log_front_point.tolist(),
-                log_axis=s.log_axis.tolist(), h_far_m=s.h_far_m, h_impact_m=s.h_impact_m)
+                log_axis=s.log_axis.tolist(), h_far_m=s.h_far_m, h_impact_m=s.h_impact_m,
+                h_log_m=s.h_log_m)
     model = (lambda: _model_2d(s, info)) if s.dim == 2 else (lambda: _model_3d(s, info))
     return _gmsh.generate(comm, f"dam{s.dim}d", model, gdim=s.dim)
 
@@ -67,17 +69,20 @@ def profile_points(s) -> list:
     return [heel] + down + up
 
 
-def _refine_near_log(s, log_entities, dim, log_volume=None, front=()):
-    """Sizes about the log; ``log_volume`` (3D): the contact ball refines the log only;
-    ``front``: the log's front-end curves (2D) or faces (3D), behind which the ball's
-    size holds only within ``contact_layer_m`` when the scenario sets it."""
+def _refine_near_log(s, log_entities, dim, log_body, log_volume=None, front=()):
+    """Sizes about the log; ``log_body``: the log's surface (2D) or volume (3D), meshed at
+    h_log when the scenario sets it finer than h_impact; ``log_volume`` (3D): the contact
+    ball refines the log only; ``front``: the log's front-end curves (2D) or faces (3D),
+    behind which the ball's size holds only within ``contact_layer_m`` when the scenario
+    sets it."""
     near = s.impact_zone_m
     far = near + 2.0 * (s.h_far_m - s.h_impact_m)  # growth rate 1/2: well-shaped grading
+    caps = [(s.h_log_m, dim + 1, [log_body])] if s.h_log_m < s.h_impact_m else []
     _gmsh.size_field(log_entities, dim, s.h_impact_m, s.h_far_m, near, far,
                      points_per_curve=max(20, int(4 * s.log_length_m / s.h_impact_m)),
                      balls=_contact_ball(s),
                      balls_only_in=[log_volume] if log_volume is not None else None,
-                     layer=_contact_layer(s, front, dim))
+                     layer=_contact_layer(s, front, dim), caps_in=caps)
 
 
 def _contact_layer(s, front, dim):
@@ -93,7 +98,7 @@ def _contact_ball(s) -> tuple:
     a crushing end's patch must be resolved: a ball of radius ``contact_zone_m`` about the
     point halfway between the log's front point and the face, growing beyond it at the rate
     1/2."""
-    if s.h_contact_m >= s.h_impact_m:
+    if s.h_contact_m >= s.h_log_m:
         return ()
     front = np.asarray(s.log_front_point, float)
     centre = front.copy()
@@ -127,7 +132,7 @@ def _model_2d(s, info):
               DAM_DOWNSTREAM: downstream, **log_curves}
     for tag, curves in groups.items():
         _gmsh.physical(1, curves, tag, NAMES[tag])
-    _refine_near_log(s, [c for cs in log_curves.values() for c in cs], 1,
+    _refine_near_log(s, [c for cs in log_curves.values() for c in cs], 1, s_log,
                      front=log_curves[LOG_FRONT])
     gmsh.model.mesh.generate(2)
     return info
@@ -228,7 +233,7 @@ def _model_3d(s, info):
     # elements, at 0.3 m it had 200,000 more cells), so the dam's near field jumped with
     # h_impact; it is now h_impact at every mesh, and the mesh study refines it evenly.
     _refine_near_log(s, faces[LOG_MANTLE] + faces[LOG_FRONT] + faces[LOG_BACK], 2, log_vol,
-                     front=faces[LOG_FRONT])
+                     log_vol, front=faces[LOG_FRONT])
     gmsh.model.mesh.generate(3)
     return info
 

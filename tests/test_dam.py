@@ -221,6 +221,8 @@ BAD = [
     (dict(water_level_m=0.5), "water_level_m=0.5"),           # too shallow to float the log
     (dict(log_pitch_deg=60.0), "log_pitch_deg=60.0"),         # front point above the crest
     (dict(refine=-1), "refine=-1"),
+    (dict(mesh_size_log_m=0.0), "mesh_size_log_m=0.0"),
+    (dict(mesh_size_log_m="fine"), "mesh_size_log_m='fine'"),
 ]
 
 

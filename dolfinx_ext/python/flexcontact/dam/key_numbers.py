@@ -142,6 +142,8 @@ def study_scenarios(s, ratio: float, contact: str = "refined") -> list:
         return s.h_contact_m / ratio ** k if contact == "refined" else s.h_contact_m
     return [s] + [s.replace(refine=0, mesh_size_far_m=s.h_far_m / ratio ** k,
                             mesh_size_impact_m=s.h_impact_m / ratio ** k,
+                            mesh_size_log_m=(None if s.mesh_size_log_m is None
+                                             else s.h_log_m / ratio ** k),
                             mesh_size_contact_m=h_contact(k))
                   for k in (1, 2)]
 

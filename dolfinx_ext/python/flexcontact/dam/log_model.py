@@ -54,7 +54,7 @@ def rotation(pitch_deg: float, yaw_deg: float = 0.0, dim: int = 2) -> np.ndarray
 
 def contact_ball(s) -> Optional[tuple]:
     """Where scenario ``s`` refines its log's end (``mesh_size_contact_m`` below
-    h_impact), in the log's own frame: (a, b, size, zone), the ball of radius
+    h_log), in the log's own frame: (a, b, size, zone), the ball of radius
     ``contact_zone_m`` at (a, b) (3D: (a, b, 0)) with elements of ``h_contact_m``; None
     without. (a, b) is the first-contact point: its axial and lateral (2D) or radial (3D)
     coordinates, to the micrometre so that every pitch and yaw with the same point shares
@@ -64,7 +64,7 @@ def contact_ball(s) -> Optional[tuple]:
     serves them all; a rounded end's moves along the cap with the angle. With
     ``contact_layer_m`` set, a fifth entry: the ball refines only that deep behind the
     front end."""
-    if s.mesh_size_contact_m is None or s.h_contact_m >= s.h_impact_m:
+    if s.mesh_size_contact_m is None or s.h_contact_m >= s.h_log_m:
         return None
     q = _first_contact_local(s)
     b = q[1] if s.dim == 2 else math.hypot(q[1], q[2])

@@ -305,7 +305,7 @@ def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> tuple[list, int]
     arrays file in ``folder`` (its K, M₁, front and W_front) and MUMPS's factor files, read
     only when a scenario asks for it."""
     from .reuse import LogCache, log_key
-    cache = LogCache(dam.dt, base.h_impact_m, dam.comm, dam.theta)
+    cache = LogCache(dam.dt, dam.comm, dam.theta)
     entries = []
     for s in logs:
         if log_key(s) in cache.models:

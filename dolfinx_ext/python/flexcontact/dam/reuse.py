@@ -53,10 +53,10 @@ def check_same_dam(base: DamScenario, scenario: DamScenario) -> None:
 
 def log_key(s: DamScenario) -> tuple:
     """What a LogModel depends on: length, diameter, density, added-mass coefficient, E, ν,
-    the front end's shape and, when the scenario refines the crushed patch, where
-    (log_model.contact_ball)."""
+    the front end's shape, the element size on the log and, when the scenario refines the
+    crushed patch, where (log_model.contact_ball)."""
     return (s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3, s.added_mass_coefficient,
-            s.wood.E_Pa, s.wood.nu, s.log_end) + _ball_key(s)
+            s.wood.E_Pa, s.wood.nu, s.log_end, s.h_log_m) + _ball_key(s)
 
 
 def _ball_key(s: DamScenario) -> tuple:
@@ -67,11 +67,11 @@ def _ball_key(s: DamScenario) -> tuple:
 class LogCache:
     """The log models of one dam at the time step ``dt_s`` and the scheme's ``theta``: one
     LogMesh per log geometry (its mesh, K and unit mass, every density), one LogModel per
-    log (log_key), each made on first use or restored from a model file. Elements of
-    ``h_m``."""
+    log (log_key), each made on first use or restored from a model file. Elements of the
+    scenario's h_log_m."""
 
-    def __init__(self, dt_s: float, h_m: float, comm, theta: float):
-        self.dt, self.h_m, self.comm, self.theta = float(dt_s), float(h_m), comm, float(theta)
+    def __init__(self, dt_s: float, comm, theta: float):
+        self.dt, self.comm, self.theta = float(dt_s), comm, float(theta)
         self.models: dict = {}
         self.meshes: dict = {}
         self.saved: dict = {}  # log_key: (scenario, loader) of a model file's large logs
@@ -80,7 +80,7 @@ class LogCache:
     @staticmethod
     def _mesh_key(s: DamScenario) -> tuple:
         return (s.log_length_m, s.log_diameter_m, s.wood.E_Pa, s.wood.nu,
-                s.log_end) + _ball_key(s)
+                s.log_end, s.h_log_m) + _ball_key(s)
 
     def get(self, s: DamScenario) -> LogModel:
         key = log_key(s)
@@ -93,7 +93,7 @@ class LogCache:
             mesh_key = self._mesh_key(s)
             if mesh_key not in self.meshes:
                 t0 = time.perf_counter()
-                self.meshes[mesh_key] = LogMesh(*mesh_key[:4], h_m=self.h_m, comm=self.comm,
+                self.meshes[mesh_key] = LogMesh(*mesh_key[:4], h_m=s.h_log_m, comm=self.comm,
                                                 end=s.log_end, dim=s.dim,
                                                 ball=contact_ball(s))
                 self.mesh_s += time.perf_counter() - t0
@@ -123,7 +123,7 @@ class LogCache:
     def _model(self, s: DamScenario, mesh, factor=None, W_front=None) -> LogModel:
         return LogModel(
             s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
-            s.wood.E_Pa, s.wood.nu, self.dt, h_m=self.h_m, theta=self.theta, comm=self.comm,
+            s.wood.E_Pa, s.wood.nu, self.dt, h_m=s.h_log_m, theta=self.theta, comm=self.comm,
             mesh=mesh, dim=s.dim, factor=factor, W_front=W_front)
 
     def setup_s(self) -> float:
@@ -169,7 +169,7 @@ class ScenarioEvaluator:
                                                         strip_m=strip_m,
                                                         patch_y_m=patch_y_m)
         self.dam.static_state(base.water_level_m)
-        self.logs = LogCache(self.dt, base.h_impact_m, self.dam.comm, self.dam.theta)
+        self.logs = LogCache(self.dt, self.dam.comm, self.dam.theta)
         self._steps_s = 0.0
         self._split: dict = {}  # run_impact's coupled steps, log-only steps, convolution
         self.setup_s = time.perf_counter() - t0

@@ -141,6 +141,9 @@ class DamScenario:
     mesh_size_far_m: Optional[float] = None
     mesh_size_impact_m: Optional[float] = None
     impact_zone_m: float = 1.0
+    # on the log, if finer than h_impact (None: h_impact): its shaft, in the whole mesh and
+    # in the log's own frame alike
+    mesh_size_log_m: Optional[float] = None
     # the first-contact point's cap (None: h_impact) within contact_zone_m of it
     mesh_size_contact_m: Optional[float] = None
     contact_zone_m: float = 0.1
@@ -218,12 +221,21 @@ class DamScenario:
         return min(h / 2 ** self.refine, self.h_far_m)
 
     @property
+    def h_log_m(self) -> float:
+        """Element size on the log (h_impact when not set, never coarser): the shaft's
+        waves and bending, which a thin log at the impact zone's size resolves by one or
+        two elements across."""
+        if self.mesh_size_log_m is None:
+            return self.h_impact_m
+        return min(self.mesh_size_log_m / 2 ** self.refine, self.h_impact_m)
+
+    @property
     def h_contact_m(self) -> float:
         """Element size within ``contact_zone_m`` of the first-contact point, where a
-        crushing end's patch must be resolved (h_impact when not set)."""
+        crushing end's patch must be resolved (h_log when not set)."""
         if self.mesh_size_contact_m is None:
-            return self.h_impact_m
-        return min(self.mesh_size_contact_m / 2 ** self.refine, self.h_impact_m)
+            return self.h_log_m
+        return min(self.mesh_size_contact_m / 2 ** self.refine, self.h_log_m)
 
     # ---- water -------------------------------------------------------------------------
     def hydrostatic_resultant_N_per_m(self) -> float:

@@ -52,8 +52,9 @@ def _check_types(s):
                    "log_speed_m_s": "the log's speed must be >= 0 m/s (it moves towards the "
                                     "dam; the direction is its axis)"}.get(name, "must be >= 0")
             _fail(name, v, why)
-    for name in ("mesh_size_far_m", "mesh_size_impact_m", "mesh_size_contact_m",
-                 "contact_layer_m", "log_end_chamfer_m", "log_end_radius_m"):
+    for name in ("mesh_size_far_m", "mesh_size_impact_m", "mesh_size_log_m",
+                 "mesh_size_contact_m", "contact_layer_m", "log_end_chamfer_m",
+                 "log_end_radius_m"):
         v = getattr(s, name)
         if v is not None and not (_real(v) and v > 0):
             _fail(name, v, "must be None (default) or a finite number > 0")
