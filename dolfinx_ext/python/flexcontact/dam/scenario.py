@@ -144,7 +144,7 @@ class DamScenario:
     # on the log, if finer than h_impact (None: h_impact): its shaft, in the whole mesh and
     # in the log's own frame alike
     mesh_size_log_m: Optional[float] = None
-    # the first-contact point's cap (None: h_impact) within contact_zone_m of it
+    # the first-contact point's cap (None: h_log) within contact_zone_m of it
     mesh_size_contact_m: Optional[float] = None
     contact_zone_m: float = 0.1
     # ... and only within contact_layer_m behind the log's front end (None: the whole ball)
