@@ -5,8 +5,9 @@ A sweep of crushing impacts at the main job's accuracy costs about half a minute
 on the factored dam block (docs/dam.md, "Sweeps"), so 1,000 of them take hours. This bench
 measures, in one run, what coarser meshes buy: for each setting (far field, impact zone, the
 log's crushed patch and, when given, the log's own element size ``mesh_size_log_m``), the
-dam's set-up (meshing, its two factorizations, W_face, the response functions for the run's
-lags, the face compliance of the re-contact bound: what a model file keeps), then three
+dam's set-up (meshing, its two factorizations, W_face, 1,200 lags of the response
+functions, more than the runs use, the face compliance of the re-contact bound: what a model
+file keeps), then three
 crushing scenarios at one time step:
 
 * A: the main job's own (10 m × Ø0.8 m log, 10° pitch, 2 m/s, flat end);
@@ -18,7 +19,9 @@ steps, as a sweep meshes each log geometry once). The errors are against the fir
 (the main job's mesh: 3 m far, 0.2 m on the impact zone, the log's end 12.5 mm within
 0.35 m of the first contact and 5 cm deep), scenario by scenario. The projection of 1,000
 scenarios on 2 workers is the set-up plus 500 times the mean scenario's steps; it
-leaves out the logs' set-up, paid once per log geometry.
+leaves out the logs' set-up, paid once per log geometry, and a whole sweep costs about twice
+that a scenario (a shorter time step, faster logs, two workers sharing the memory bus:
+docs/dam.md, "The 3D sweep's trade-off").
 
     /usr/bin/python3 bench/sweep_tradeoff_3d.py [--settings 3,0.2,0.0125 6,0.4,0.025,0.2 ...]
 
