@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Install what is needed, build, and run the main job: the dam–log impact demo (outputs in
-# results/dam_debris/), then a short sweep of 32 impact scenarios on the 3D dam block (outputs
-# in results/sweep/sweep_3d/, with the dam model it prepares once in dam_model/ there; run
-# again after an interruption, it resumes).
+# results/dam_debris/), then a short sweep of 32 impacts of crushing logs on the 3D dam block
+# (outputs in results/sweep/sweep_3d_crushing/, with the dam model it prepares once in
+# dam_model/ there; run again after an interruption, it resumes).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 bash "$here/scripts/setup.sh"
@@ -21,6 +21,6 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 cd "$here"
 /usr/bin/python3 demos/dam_debris.py "$@"
-/usr/bin/python3 -m flexcontact sweep examples/sweep_3d.toml
+/usr/bin/python3 -m flexcontact sweep examples/sweep_3d_crushing.toml
 echo "Outputs: $here/results/dam_debris/ (report.md, XDMF for ParaView, PNG pictures, summary.json)"
-echo "         $here/results/sweep/sweep_3d/ (report.md, results.csv, summary.json, exceedance and envelope plots)"
+echo "         $here/results/sweep/sweep_3d_crushing/ (report.md, results.csv, summary.json, exceedance and envelope plots)"

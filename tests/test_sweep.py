@@ -633,3 +633,26 @@ def test_command_line_names_the_worst_end_shape(tmp_path):
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     worst = summary["worst"]["peak_force_N_per_m"]
     assert f"log_end_shape={worst['inputs']['log_end_shape']}" in proc.stdout
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "examples").glob("sweep_*.toml")))
+def test_the_example_sweeps_build_every_scenario(name):
+    """Each shipped sweep config is checked and builds all its scenarios before anything is
+    computed (a stale key would otherwise surface only in the main job)."""
+    cfg = sweep.config.load(ROOT / "examples" / name)
+    base, points, scenarios = build_scenarios(cfg)
+    assert len(scenarios) == cfg.n == 32
+
+
+def test_the_main_jobs_sweep_is_the_measured_30_minute_mesh():
+    """docs/dam.md states the closing sweep's error from the trade-off row of
+    bench/sweep_1000_3d_crushing.toml's mesh: the two must stay the same mesh and physics."""
+    closing = sweep.config.load(ROOT / "examples" / "sweep_3d_crushing.toml")
+    bench = sweep.config.load(ROOT / "bench" / "sweep_1000_3d_crushing.toml")
+    b_close, _, _ = build_scenarios(closing)
+    b_bench, _, _ = build_scenarios(bench)
+    keys = ("dim", "log_end_crushes", "h_far_m", "h_impact_m", "h_log_m", "h_contact_m",
+            "contact_zone_m", "contact_layer_m", "time_scheme_theta")
+    assert {k: getattr(b_close, k) for k in keys} == {k: getattr(b_bench, k) for k in keys}
+    assert b_close.log_end_crushes
+    assert "sweep_3d_crushing.toml" in (ROOT / "scripts" / "main.sh").read_text()
