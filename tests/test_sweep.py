@@ -263,7 +263,11 @@ def test_worst_exceedance_rank_correlation_and_counts_are_exact(tmp_path):
     c = summary["counts"]
     assert c["factorizations"] == {"dam": 2, "log": 3, "total": 5}
     assert c["back_substitutions"]["steps"] == sum(e["steps"] for e in expected)
-    assert "not an annual probability" in (tmp_path / "out" / "report.md").read_text()
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "not an annual probability" in report
+    # The 2D section's default sizes, stated beside the numbers they decide.
+    assert "Elements: the dam 3.00 m far from the impact and 0.200 m near it, the log 0.200 m." \
+        in report
 
 
 def test_bootstrap_band_is_seeded(tmp_path):
@@ -554,6 +558,10 @@ def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):
     report = (tmp_path / "out" / "report.md").read_text()
     assert "3D dam block" in report and "MN/m" not in report
     assert "by the monolithic evaluator" in report
+    # 0.4 m elements against Boussinesq's tension layer 0.085 m deep at 1 m: not resolved.
+    assert ("Elements: the dam 6.00 m far from the impact and 0.400 m near it, the log "
+            "0.400 m. At 1.00 m from the impact the face's tension lies in a layer about "
+            "8.50 cm deep, thinner than the 0.400 m elements") in report
 
 
 # ---- a categorical input: the log's end shape ---------------------------------------------

@@ -206,6 +206,7 @@ def finish(cfg, folder: Path, table: ResultTable, prep: dict, computed: int, wal
                 "seconds_per_scenario_mean": (sum(r["seconds"] for r in rows) / len(rows)
                                               if rows else math.nan),
                 "base": prep["base"].as_dict(),
+                "mesh": _element_sizes(prep["base"]),
                 "evaluator_timings_s": _sum_timings(rows)}
     if "model" in prep:
         run_info["dam_model"] = prep["model"]
@@ -262,3 +263,11 @@ def convergence(prep: dict, worst: dict) -> dict:
                   "relative_change": (v1 - v) / abs(v) if v else math.nan,
                   "outputs_refined": cache[w["id"]]}
     return out
+
+
+def _element_sizes(base) -> dict:
+    """The element sizes every scenario is meshed with (m), resolved from the base scenario's
+    defaults, for the report: its numbers mean little without them."""
+    return {"h_far_m": base.h_far_m, "h_impact_m": base.h_impact_m, "h_log_m": base.h_log_m,
+            "h_contact_m": base.h_contact_m, "contact_zone_m": base.contact_zone_m,
+            "contact_layer_m": base.contact_layer_m}

@@ -18,6 +18,9 @@ from .quantities import quantity, three_figures
 
 PROBABILITIES = (0.5, 0.1, 0.01)
 """Exceedance probabilities at which the report quotes the value exceeded."""
+TENSION_LAYER = 0.085
+"""Depth, over the distance r from a point force on a half-space's face, within which the
+face's radial tension halves (docs/dam.md, "The peak principal stress near the impact")."""
 
 
 def exceeded_at(curve: dict) -> dict:
@@ -129,7 +132,7 @@ def markdown(summary: dict, inputs: list) -> str:
          + (f" (dam {three_figures(base['dam_height_m'])} m high"
             f", concrete tensile strength "
             f"{three_figures(base['concrete_tensile_strength_Pa'], 1e-6)} MPa)"
-            if "dam_height_m" in base else "") + ". " + _end(base), ""]
+            if "dam_height_m" in base else "") + ". " + _end(base) + _mesh(s), ""]
     if s.get("input_ranges"):
         L += ["## Inputs", "", "The range each input took over the sweep.", "",
               *_inputs_table(dim, s["input_ranges"]), ""]
@@ -230,6 +233,31 @@ def _end(base: dict) -> str:
                 f"{three_figures(base['wood_crushing_strength_Pa'], 1e-6)} MPa.")
     return (f"The log's {shape} end does not crush: the forces are the elastic bound of an "
             "intact log, above what a crushing end transmits.")
+
+
+def _mesh(s: dict) -> str:
+    """The element sizes, and in 3D whether they resolve the stress near the impact."""
+    m = s.get("mesh")
+    if not m:
+        return ""
+    text = (f" Elements: the dam {three_figures(m['h_far_m'])} m far from the impact and "
+            f"{three_figures(m['h_impact_m'])} m near it, the log "
+            f"{three_figures(m['h_log_m'])} m")
+    if m["h_contact_m"] < m["h_log_m"]:
+        text += (f", its end {three_figures(m['h_contact_m'], 1e3)} mm within "
+                 f"{three_figures(m['contact_zone_m'])} m of the first contact")
+        if m.get("contact_layer_m") is not None:
+            text += f" and {three_figures(m['contact_layer_m'], 1e3)} mm deep"
+    text += "."
+    offset = next((w["outputs"].get("stress_offset_m") for w in s.get("worst", {}).values()
+                   if w), None)
+    if s.get("dim") == 3 and offset is not None and m["h_impact_m"] > TENSION_LAYER * offset:
+        text += (f" At {three_figures(offset)} m from the impact the face's tension lies in a "
+                 f"layer about {three_figures(TENSION_LAYER * offset, 1e2)} cm deep, "
+                 f"thinner than the {three_figures(m['h_impact_m'])} m elements: the peak "
+                 "principal stress read there is low and grows as the mesh is refined; the "
+                 "half-space tension does not depend on the mesh.")
+    return text
 
 
 def _computation(s: dict) -> list:
