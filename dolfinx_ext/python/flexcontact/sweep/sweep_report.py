@@ -137,8 +137,7 @@ def markdown(summary: dict, inputs: list) -> str:
         L += ["## Inputs", "", "The range each input took over the sweep.", "",
               *_inputs_table(dim, s["input_ranges"]), ""]
     L += ["## Design outputs", "", "| output | unit | definition |", "|---|---|---|"]
-    offset = next((w["outputs"].get("stress_offset_m") for w in s["worst"].values() if w),
-                  None)
+    offset = _stress_offset(s)
     for o in s["spearman"] or s["worst"]:
         d = q[o].definition
         if o in ("peak_tensile_stress_Pa", "halfspace_tension_Pa") and offset is not None:
@@ -235,6 +234,13 @@ def _end(base: dict) -> str:
             "intact log, above what a crushing end transmits.")
 
 
+def _stress_offset(s: dict):
+    """The distance from the first contact at which the stresses near the impact are read
+    (the same in every scenario), or None."""
+    return next((w["outputs"].get("stress_offset_m") for w in s.get("worst", {}).values()
+                 if w), None)
+
+
 def _mesh(s: dict) -> str:
     """The element sizes, and in 3D whether they resolve the stress near the impact."""
     m = s.get("mesh")
@@ -249,8 +255,7 @@ def _mesh(s: dict) -> str:
         if m.get("contact_layer_m") is not None:
             text += f" and {three_figures(m['contact_layer_m'], 1e3)} mm deep"
     text += "."
-    offset = next((w["outputs"].get("stress_offset_m") for w in s.get("worst", {}).values()
-                   if w), None)
+    offset = _stress_offset(s)
     if s.get("dim") == 3 and offset is not None and m["h_impact_m"] > TENSION_LAYER * offset:
         text += (f" At {three_figures(offset)} m from the impact the face's tension lies in a "
                  f"layer about {three_figures(TENSION_LAYER * offset, 1e2)} cm deep, "
