@@ -150,6 +150,7 @@ private:
   std::vector<int> irn_, jcn_, listvar_, perm_in_;
   std::vector<double> a_, schur_, redrhs_, rhs_, condensed_rhs_;
   bool schur_is_inverse_ = false;
+  bool schur_symmetric_ = false; ///< F* exactly symmetric: a product reads its lower half
   std::shared_ptr<const BlockFlexibility> factors_; ///< F* by block, when kept so
   bool condensed_ = false;
   VecScatter to_zero_ = nullptr; ///< K's row layout → all on rank 0

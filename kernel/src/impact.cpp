@@ -293,7 +293,7 @@ ImpactStep ImpactContact::step(const Eigen::Ref<const Vector>& u_c,
     r.velocity = detail::full_u(columns_, act, P_act, Ufree, d);
   }
   else
-    r.velocity = W_ * r.impulse + Ufree;
+    r.velocity = Ufree + impulse_effect(r);
   finish(r);
   if (cap_.size())
     crush(r);
@@ -419,6 +419,21 @@ void ImpactContact::solve_active(ImpactStep& r, const Vector& Ufree)
   for (std::size_t a = 0; a < act.size(); ++a)
     r.states[act[a]] = rep.states[a];
   r.report = std::move(rep);
+}
+
+Vector ImpactContact::impulse_effect(const ImpactStep& r) const
+{
+  // P is zero outside the index set. When few pairs are in it, their columns of W (column
+  // major, so contiguous) are all the product needs: at the main job's 1,400 crushing
+  // pairs, W is 140 MB, read whole each step for an index set of a few hundred at most.
+  const int m = pairs(), d = dim_;
+  if (2 * r.active_pairs >= m)
+    return W_ * r.impulse;
+  Vector y = Vector::Zero(W_.rows());
+  for (int k = 0; k < m; ++k)
+    if (r.active[k])
+      y.noalias() += W_.middleCols(k * d, d) * r.impulse.segment(k * d, d);
+  return y;
 }
 
 void ImpactContact::finish(ImpactStep& r) const

@@ -296,6 +296,38 @@ TEST(Impact, CondensedStepOnAFewOfManyContactNodesEqualsTheWholeProduct)
   EXPECT_EQ(r.velocity_change_c.norm(), 0.0);
 }
 
+TEST(Impact, TheVelocityAfterAStepReadsOnlyTheClosedPairsColumnsOfW)
+{
+  // Four pairs (slave k on master k + 4, normal x), all touching: U⁺ = W P + U_free with P
+  // zero outside the index set. With one pair closing, the product reads that pair's
+  // columns of W only; with all four closing, all of W. Both equal the whole product.
+  const int n = 16;
+  Matrix F = Matrix::Zero(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      F(i, j) = 1.0 / (1.0 + i + j) + (i == j ? 1.0 : 0.0); // SPD (Hilbert + I)
+  std::vector<ContactPair> pairs;
+  for (int k = 0; k < 4; ++k)
+    pairs.push_back(make_pair(k, {k + 4}, {1.0}, vec({1.0, 0.0})));
+  const Matrix X = Matrix::Zero(8, 2);
+  const Vector mu = Vector::Constant(4, 0.3);
+  for (const int closing : {1, 4})
+  {
+    ImpactContact c(2, F, X, pairs, mu, 0.0, 1e-3, 0.5);
+    Vector v = Vector::Zero(n);
+    for (int k = 0; k < 4; ++k)
+    {
+      v[2 * k] = k < closing ? -0.5 - 0.1 * k : 0.5; // the slave's x: closing or opening
+      v[2 * k + 1] = 0.05 * (k + 1);                  // and a tangential slip
+    }
+    const ImpactStep s = c.step(Vector::Zero(n), v, v);
+    ASSERT_EQ(s.active_pairs, closing);
+    const Vector expected = c.W() * s.impulse + s.velocity_before;
+    EXPECT_LE((s.velocity - expected).norm(), 1e-14 * expected.norm()) << closing;
+    EXPECT_GT(s.impulse.norm(), 0.0);
+  }
+}
+
 TEST(Impact, CondensedStepGoesByTheDiagonalBlocksOfTwoBodies)
 {
   // Two bodies condensed apart, three contact nodes each (DOFs 0–5 and 6–11), three pairs

@@ -188,6 +188,8 @@ private:
   void start();
   /// @brief Impulses of the pairs in I from the local problem x = W_II P + q_I.
   void solve_active(ImpactStep& r, const Vector& Ufree);
+  /// @brief W P, reading only the index set's columns of W when they are few.
+  Vector impulse_effect(const ImpactStep& r) const;
   /// @brief Reaction, totals and the energy terms of a solved step.
   void finish(ImpactStep& r) const;
   /// @brief Crush depths and crushing work of a solved step (pairs at their cap).
