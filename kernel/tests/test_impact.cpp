@@ -37,6 +37,16 @@ struct ImpactRun
   double energy0 = 0.0, energy = 0.0;
 };
 
+/// @brief A dense symmetric positive definite n × n flexibility: the Hilbert matrix plus I.
+Matrix hilbert_plus_identity(int n)
+{
+  Matrix A(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      A(i, j) = 1.0 / (1.0 + i + j) + (i == j ? 1.0 : 0.0);
+  return A;
+}
+
 double energy(const Matrix& M, const Matrix& K, const Vector& u, const Vector& v)
 {
   return 0.5 * v.dot(M * v) + 0.5 * u.dot(K * u);
@@ -242,10 +252,7 @@ TEST(Impact, CondensedStepOnAFewOfManyContactNodesEqualsTheWholeProduct)
   // after it from one product F (b + r). It must equal the two whole products of
   // v_free = v + F b, Δv = F b + F r, on every DOF, held ones (node 4) included.
   const int n = 10;
-  Matrix A = Matrix::Zero(n, n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      A(i, j) = 1.0 / (1.0 + i + j) + (i == j ? 1.0 : 0.0); // SPD (Hilbert + I)
+  const Matrix A = hilbert_plus_identity(n);
   std::vector<bool> held(n, false);
   held[8] = held[9] = true;
   Matrix F = A;
@@ -302,10 +309,7 @@ TEST(Impact, TheVelocityAfterAStepReadsOnlyTheClosedPairsColumnsOfW)
   // zero outside the index set. With one pair closing, the product reads that pair's
   // columns of W only; with all four closing, all of W. Both equal the whole product.
   const int n = 16;
-  Matrix F = Matrix::Zero(n, n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      F(i, j) = 1.0 / (1.0 + i + j) + (i == j ? 1.0 : 0.0); // SPD (Hilbert + I)
+  const Matrix F = hilbert_plus_identity(n);
   std::vector<ContactPair> pairs;
   for (int k = 0; k < 4; ++k)
     pairs.push_back(make_pair(k, {k + 4}, {1.0}, vec({1.0, 0.0})));
