@@ -216,3 +216,22 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
     (path / lost).unlink()
     with pytest.raises(SavedFileError, match=f"{lost}: missing"):
         model_file.load(path)
+
+
+def test_every_what_if_option_says_what_it_is_and_its_unit():
+    """`dam what-if --help` explains each scenario input it takes, and each is a field of
+    DamScenario or the wood's density (a renamed field would otherwise leave a dead
+    option)."""
+    import dataclasses
+    from flexcontact.dam.cli import WHAT_IF_HELP, WHAT_IF_INPUTS
+    assert set(WHAT_IF_HELP) == set(WHAT_IF_INPUTS)
+    fields = {f.name for f in dataclasses.fields(DamScenario)}
+    assert set(WHAT_IF_INPUTS) - fields <= {"wood_density_kg_m3"}  # DamScenario.wood's
+    r = cli("what-if", "--help")
+    assert r.returncode == 0, r.stderr
+    text = " ".join(r.stdout.split())   # argparse wraps the help lines
+    for name in WHAT_IF_INPUTS:
+        assert "--" + name.replace("_", "-") in text, name
+        assert " ".join(WHAT_IF_HELP[name].split()) in text, name
+    for unit in ("m/s", "degrees", "kg/m³", ", Pa", ", m"):
+        assert unit in text, unit

@@ -15,6 +15,24 @@ WHAT_IF_INPUTS = ("log_speed_m_s", "log_pitch_deg", "log_length_m", "log_diamete
 """The scenario's inputs a what-if may change (yaw and the place across the block in 3D);
 the rest are the model's base."""
 
+WHAT_IF_HELP = {
+    "log_speed_m_s": "the log's speed along its axis, m/s",
+    "log_pitch_deg": "pitch, degrees (front end up for a positive angle)",
+    "log_length_m": "log length, m",
+    "log_diameter_m": "log diameter, m",
+    "wood_density_kg_m3": "wood density, kg/m³",
+    "friction_mu": "Coulomb friction between log and face",
+    "water_level_m": "water level above the dam's base, m (within the model's range)",
+    "added_mass_coefficient": "added mass of the water the log drags, C_a",
+    "wood_crushing_strength_Pa": "crushing strength parallel to the grain, Pa",
+    "log_end_shape": "flat, chamfered or rounded",
+    "log_end_chamfer_m": "the bevel of a chamfered end, m",
+    "log_end_radius_m": "the cap radius of a rounded end, m (at least D/2)",
+    "log_yaw_deg": "3D: yaw about the vertical axis, degrees",
+    "log_across_m": "3D: the log centre's y along the dam axis, m (0 to the block width)",
+}
+"""What each what-if option means, with its unit; every one defaults to the model's base."""
+
 
 def add_parser(sub) -> None:
     p = sub.add_parser("dam", help="a dam model: prepare it once, ask it what-if questions")
@@ -25,10 +43,11 @@ def add_parser(sub) -> None:
     prep.add_argument("--out", type=Path, default=None,
                       help="model directory (default results/dam_model/<config stem>)")
     w = dsub.add_parser("what-if", help="one scenario from a saved dam model")
-    w.add_argument("model", type=Path)
+    w.add_argument("model", type=Path, help="a model directory written by prepare")
     for name in WHAT_IF_INPUTS:
         w.add_argument("--" + name.replace("_", "-"), dest=name, default=None,
-                       type=str if name == "log_end_shape" else float)
+                       type=str if name == "log_end_shape" else float,
+                       help=WHAT_IF_HELP[name] + " (default: the model's base scenario)")
     w.add_argument("--json", action="store_true", help="print the outputs as JSON")
 
 
