@@ -31,6 +31,46 @@ def test_triangle_interior_and_edge():
     assert np.allclose(w[1], [0.0, 0.5, 0.5], atol=1e-14) and border[1]
 
 
+def _grid(nx, ny, quads):
+    """A planar grid of the unit square in the plane x = 0: triangles or quadrilaterals."""
+    ys, zs = np.meshgrid(np.linspace(0, 1, nx), np.linspace(0, 1, ny), indexing="ij")
+    X = np.stack([np.zeros(ys.size), ys.ravel(), zs.ravel()], axis=1)
+    idx = np.arange(ys.size).reshape(nx, ny)
+    a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+    c, d = idx[:-1, 1:].ravel(), idx[1:, 1:].ravel()
+    if quads:
+        return X, np.stack([a, b, c, d], axis=1)
+    return X, np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
+
+
+@pytest.mark.parametrize("surface", ["triangles", "quadrilaterals", "segments"])
+def test_many_points_measured_against_near_facets_only_give_the_same_answer(surface,
+                                                                            monkeypatch):
+    """Above _NEAR_ONLY point × facet combinations only the facets near each point are
+    measured (projection._candidates): the facet, the weights and the border flags equal,
+    bit for bit, those measured against every facet, ties included (points over the grid's
+    nodes and edges, where several facets hold the same closest point)."""
+    import flexcontact.projection as projection
+    rng = np.random.default_rng(7)
+    if surface == "segments":
+        t = np.linspace(0.0, 3.0, 800)
+        X = np.stack([t, 0.1 * np.sin(t)], axis=1)
+        facets = np.stack([np.arange(799), np.arange(1, 800)], axis=1)
+        P = np.concatenate([X[rng.integers(0, 800, 200)] + [0.0, 0.01],
+                            rng.uniform(-0.5, 3.5, (400, 2))])
+    else:
+        X, facets = _grid(60, 50, surface == "quadrilaterals")
+        P = np.concatenate([X[rng.integers(0, len(X), 300)] + [0.01, 0.0, 0.0],
+                            rng.uniform(-0.2, 1.2, (300, 3))])
+    assert P.shape[0] * facets.shape[0] > projection._NEAR_ONLY
+    near = closest_points(P, X, facets)
+    assert projection._candidates(P, X, facets) is not None  # the near path was taken
+    monkeypatch.setattr(projection, "_NEAR_ONLY", 10**18)
+    everywhere = closest_points(P, X, facets)
+    for a, b in zip(near, everywhere):
+        assert np.array_equal(a, b)
+
+
 def test_bilinear_quadrilateral_weights():
     # A planar, non-parallelogram quadrilateral, corners in tensor order (0,0), (1,0), (0,1),
     # (1,1); a point above x(ξ, η) has the bilinear shape functions at (ξ, η) as weights.

@@ -12,6 +12,7 @@ import numpy as np
 from .errors import InputError
 
 _CHUNK = 2_000_000  # point × facet combinations per vectorised batch
+_NEAR_ONLY = 200_000  # above this many combinations, only the facets near each point
 
 
 def _segment(P, A, B):
@@ -71,12 +72,53 @@ def _bilinear_refine(p, Xf, w_tri, steps=12):
     return np.array([(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t])
 
 
+def _distances(p, corners, d: int, nv: int):
+    """Weights (…, nv) of the closest points of points ``p`` on the facets whose corner
+    arrays are ``corners`` (broadcast against ``p``), and the squared distances (…)."""
+    if d == 2:
+        t, dist = _segment(p, corners[0], corners[1])
+        return np.stack([1.0 - t, t], axis=-1), dist
+    if nv == 3:
+        return _triangle(p, *corners)
+    # Quadrilateral (0,1,2,3 tensor order) split along the 0–3 diagonal.
+    w1, d1 = _triangle(p, corners[0], corners[1], corners[3])
+    w2, d2 = _triangle(p, corners[0], corners[3], corners[2])
+    first = d1 <= d2
+    w = np.zeros(first.shape + (4,))
+    w[..., [0, 1, 3]] = np.where(first[..., None], w1, 0.0)
+    w[..., [0, 3, 2]] += np.where(first[..., None], 0.0, w2)
+    return w, np.minimum(d1, d2)
+
+
+def _candidates(P, X, facets):
+    """Per point, the facets that may hold its closest point, or None when that would not
+    cut the work. A facet lies in a ball of radius r_f about its centroid c_f, so it is at
+    least |p − c_f| − r_f from p, and the nearest centroid's facet at most |p − c_n| + r_max:
+    the facets with |p − c_f| ≤ |p − c_n| + 2 r_max hold every closest point (a superset,
+    in ascending facet order, so ties go to the lowest index as over all facets)."""
+    from scipy.spatial import cKDTree
+    A = X[facets]
+    c = A.mean(axis=1)
+    r_max = float(np.sqrt(((A - c[:, None, :]) ** 2).sum(axis=2)).max())
+    tree = cKDTree(c)
+    near, _ = tree.query(P)
+    scale = max(float(np.abs(P).max()), float(np.abs(c).max()), 1.0)
+    lists = tree.query_ball_point(P, near + 2.0 * r_max + 1e-9 * scale)
+    counts = np.array([len(a) for a in lists])
+    if counts.sum() * 4 > P.shape[0] * facets.shape[0]:
+        return None
+    return np.repeat(np.arange(P.shape[0]), counts), np.concatenate(
+        [np.sort(np.asarray(a, np.int64)) for a in lists]), counts
+
+
 def closest_points(P: np.ndarray, X: np.ndarray, facets: np.ndarray):
     """Closest points of points P (n, d) on the surface of facets (nf, nv) over nodes X.
 
     Returns (facet (n,), weights (n, nv), border (n,) bool): the facet holding the closest
     point, its shape-function weights there, and whether some weight is zero (the point
-    lies on the facet's border, e.g. beyond the edge of the surface).
+    lies on the facet's border, e.g. beyond the edge of the surface). Many points on many
+    facets are measured against the facets near them only (:func:`_candidates`), with the
+    same answer as against all.
     """
     P, X, facets = np.asarray(P, float), np.asarray(X, float), np.asarray(facets)
     n, (nf, nv) = P.shape[0], facets.shape
@@ -85,28 +127,27 @@ def closest_points(P: np.ndarray, X: np.ndarray, facets: np.ndarray):
         raise InputError("closest_points: the surface has no facets")
     best = np.empty(n, np.int64)
     weights = np.empty((n, nv))
-    chunk = max(1, _CHUNK // nf)
-    corners = [X[facets[:, j]][None] for j in range(nv)]
-    for start in range(0, n, chunk):
-        p = P[start:start + chunk, None, :]
-        if d == 2:
-            t, dist = _segment(p, corners[0], corners[1])
-            w = np.stack([1.0 - t, t], axis=-1)
-        elif nv == 3:
-            w, dist = _triangle(p, *corners)
-        else:
-            # Quadrilateral (0,1,2,3 tensor order) split along the 0–3 diagonal.
-            w1, d1 = _triangle(p, corners[0], corners[1], corners[3])
-            w2, d2 = _triangle(p, corners[0], corners[3], corners[2])
-            first = d1 <= d2
-            w = np.zeros(first.shape + (4,))
-            w[..., [0, 1, 3]] = np.where(first[..., None], w1, 0.0)
-            w[..., [0, 3, 2]] += np.where(first[..., None], 0.0, w2)
-            dist = np.minimum(d1, d2)
-        k = np.argmin(dist, axis=1)
-        rows = np.arange(k.size)
-        best[start:start + k.size] = k
-        weights[start:start + k.size] = w[rows, k]
+    near = _candidates(P, X, facets) if n * nf > _NEAR_ONLY else None
+    if near is not None:
+        point, facet, counts = near
+        w, dist = _distances(P[point][:, None, :],
+                             [X[facets[facet, j]][:, None, :] for j in range(nv)], d, nv)
+        w, dist = w[:, 0], dist[:, 0]
+        # The first smallest distance of each point's run, as argmin over all facets.
+        first = np.lexsort((np.arange(dist.size), dist, point))
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        pick = first[starts]
+        best[:] = facet[pick]
+        weights[:] = w[pick]
+    else:
+        chunk = max(1, _CHUNK // nf)
+        corners = [X[facets[:, j]][None] for j in range(nv)]
+        for start in range(0, n, chunk):
+            w, dist = _distances(P[start:start + chunk, None, :], corners, d, nv)
+            k = np.argmin(dist, axis=1)
+            rows = np.arange(k.size)
+            best[start:start + k.size] = k
+            weights[start:start + k.size] = w[rows, k]
     if d == 3 and nv == 4:
         for i in range(n):
             weights[i] = _bilinear_refine(P[i], X[facets[best[i]]], weights[i])
