@@ -127,7 +127,10 @@ def closest_points(P: np.ndarray, X: np.ndarray, facets: np.ndarray):
         raise InputError("closest_points: the surface has no facets")
     best = np.empty(n, np.int64)
     weights = np.empty((n, nv))
-    near = _candidates(P, X, facets) if n * nf > _NEAR_ONLY else None
+    # A non-finite coordinate (a diverged state) keeps the measure against all facets, and
+    # so the same answer as ever, for the caller's own checks to name.
+    near = (_candidates(P, X, facets)
+            if n * nf > _NEAR_ONLY and np.isfinite(P).all() and np.isfinite(X).all() else None)
     if near is not None:
         point, facet, counts = near
         w, dist = _distances(P[point][:, None, :],
