@@ -8,13 +8,6 @@ import sys
 import time
 from pathlib import Path
 
-WHAT_IF_INPUTS = ("log_speed_m_s", "log_pitch_deg", "log_length_m", "log_diameter_m",
-                  "wood_density_kg_m3", "friction_mu", "water_level_m",
-                  "added_mass_coefficient", "wood_crushing_strength_Pa", "log_end_shape",
-                  "log_end_chamfer_m", "log_end_radius_m", "log_yaw_deg", "log_across_m")
-"""The scenario's inputs a what-if may change (yaw and the place across the block in 3D);
-the rest are the model's base."""
-
 WHAT_IF_HELP = {
     "log_speed_m_s": "the log's speed along its axis, m/s",
     "log_pitch_deg": "pitch, degrees (front end up for a positive angle)",
@@ -32,6 +25,10 @@ WHAT_IF_HELP = {
     "log_across_m": "3D: the log centre's y along the dam axis, m (0 to the block width)",
 }
 """What each what-if option means, with its unit; every one defaults to the model's base."""
+
+WHAT_IF_INPUTS = tuple(WHAT_IF_HELP)
+"""The scenario's inputs a what-if may change (yaw and the place across the block in 3D);
+the rest are the model's base."""
 
 
 def add_parser(sub) -> None:
