@@ -12,8 +12,12 @@ crushing end, and asks the main job's own scenario (bench/dam_what_if_main_job.j
 that its outputs can be set beside the main job's. ``--ab-saved-logs`` also times, run
 for run alternated with the model, the same model without its logs (the dam's files only,
 the log then meshed and factored by each what-if), and records the ratio pair by pair.
+``--ab-flight`` does the same against the model as format 3 wrote it: its large logs
+without their plain factor, so that they fly after the contact on their Schur factor's full
+solves (the answers must agree to 1e-10).
 
-    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3 | --main-job] [--ab-saved-logs]
+    /usr/bin/python3 bench/dam_what_if.py [--runs 5] [--dim 3 | --main-job]
+                                          [--ab-saved-logs | --ab-flight]
 """
 import argparse
 import json
@@ -33,8 +37,12 @@ ap.add_argument("--main-job", action="store_true",
                 help="the 3D block at the main job's mesh, crushing end, main job's scenario")
 ap.add_argument("--ab-saved-logs", action="store_true",
                 help="alternate each run with the same model stripped of its logs")
+ap.add_argument("--ab-flight", action="store_true",
+                help="alternate each run with the same model without its logs' plain factors")
 ap.add_argument("--out", default=None)
 args = ap.parse_args()
+if args.ab_saved_logs and args.ab_flight:
+    ap.error("--ab-saved-logs and --ab-flight: one comparison per run")
 if args.main_job:
     args.dim = 3
 if args.out is None:
@@ -70,12 +78,26 @@ with tempfile.TemporaryDirectory() as tmp:
             sys.exit("--ab-saved-logs: a log held dense sits in arrays.npz; this compares "
                      "large logs only")
         log_files = {f for e in manifest["logs"]
-                     for f in [e["arrays"], *e["factor"]["files"]]}
+                     for f in [e["arrays"], *e["factor"]["files"],
+                               *e.get("flight_factor", {}).get("files", [])]}
         for p in model.iterdir():
             if p.name not in log_files and p.name != "manifest.json":
                 os.link(p, bare / p.name)
         manifest["files"] = {k: v for k, v in manifest["files"].items() if k not in log_files}
         manifest["logs"] = []
+        (bare / "manifest.json").write_text(json.dumps(manifest))
+    if args.ab_flight:
+        # The same files, read as format 3: the large logs lose their plain factor.
+        bare = Path(tmp) / "model_format_3"
+        bare.mkdir()
+        manifest = json.loads((model / "manifest.json").read_text())
+        flight = {f for e in manifest["logs"] for f in e.pop("flight_factor", {}).get("files", [])}
+        if not flight:
+            sys.exit("--ab-flight: the model has no large log")
+        for p in model.iterdir():
+            if p.name not in flight and p.name != "manifest.json":
+                os.link(p, bare / p.name)
+        manifest["format"] = 3
         (bare / "manifest.json").write_text(json.dumps(manifest))
 
     def what_if(path):
@@ -96,9 +118,16 @@ with tempfile.TemporaryDirectory() as tmp:
             run, bare_outputs = what_if(bare)
             runs_bare.append(run)
             timing = {"evaluate_s"}  # the evaluator's own clock, the only output that may differ
-            if ({k: v for k, v in bare_outputs.items() if k not in timing}
+            if args.ab_saved_logs and (
+                    {k: v for k, v in bare_outputs.items() if k not in timing}
                     != {k: v for k, v in outputs.items() if k not in timing}):
                 sys.exit("--ab-saved-logs: the answers differ with and without the saved log")
+            if args.ab_flight:
+                # Another factor's round-off in the log's flight: equal to 1e-10.
+                far = [k for k, v in outputs.items() if k not in timing
+                       and isinstance(v, float) and abs(v - bare_outputs[k]) > 1e-10 * abs(v)]
+                if far:
+                    sys.exit(f"--ab-flight: the answers differ beyond 1e-10 in {far}")
 result = {
     "what": ("dam what-if from a saved model, "
              + ("3D block at the main job's mesh, crushing end" if args.main_job
@@ -114,11 +143,13 @@ result = {
                  for k in ("command_s", "load_s", "evaluate_s")},
     "load_average_1min": os.getloadavg()[0], "machine": machine()}
 if runs_bare:
-    result["runs_without_saved_logs"] = runs_bare
-    result["with_over_without_saved_logs"] = {
+    name = "saved_logs" if args.ab_saved_logs else "the_logs_plain_factors"
+    result[f"runs_without_{name}"] = runs_bare
+    result[f"with_over_without_{name}"] = {
         k: statistics.median(a[k] / b[k] for a, b in zip(runs, runs_bare))
         for k in ("command_s", "evaluate_s")}
 Path(args.out).write_text(json.dumps(result, indent=1))
 print(json.dumps(result["median_s"]), f"prepare {prepare_s:.1f} s, model {size / 1e6:.1f} MB")
 if runs_bare:
-    print("with / without the saved logs:", json.dumps(result["with_over_without_saved_logs"]))
+    print(f"with / without {name.replace('_', ' ')}:",
+          json.dumps(result[f"with_over_without_{name}"]))

@@ -177,8 +177,10 @@ BASE_FINE_LOG = DamScenario(mesh_size_far_m=6.0, mesh_size_impact_m=0.4,
 
 def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
     """A log above the dense limit (its crushed patch refined: 1,980 DOFs) is kept as its
-    own arrays and MUMPS's Schur factor: a what-if in a new process restores it instead of
-    meshing and factoring it, and answers as the evaluator that factored it (1e-10). A model
+    own arrays, MUMPS's Schur factor and its plain factor (its flight after the contact): a
+    what-if in a new process restores both instead of meshing and factoring it, and answers
+    as the evaluator that factored it (1e-10). Flying on the Schur factor's full solves
+    instead (a format-3 model, which still loads) gives the same answer (1e-10). A model
     whose log factor file is gone is refused naming the file."""
     dt = sweep_time_step_s([BASE_FINE_LOG])
     levels = (BASE_FINE_LOG.water_level_m,) * 2
@@ -187,7 +189,8 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
                                   logs=[BASE_FINE_LOG])
     (entry,) = manifest["logs"]
     assert entry["factor"]["kind"] == "schur" and entry["arrays"] in manifest["files"]
-    assert manifest["counts"]["factorizations"]["log"] == 1  # counted where it was made
+    assert "kind" not in entry["flight_factor"]  # a plain factor
+    assert manifest["counts"]["factorizations"]["log"] == 2  # counted where they were made
     asked = {"log_speed_m_s": 3.0, "log_pitch_deg": 12.0}
     got = what_if_json(path, asked)
     own = ScenarioEvaluator(BASE_FINE_LOG, dt, levels, MPI.COMM_SELF)
@@ -196,12 +199,32 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
     for key in OUTPUTS:
         assert got["outputs"][key] == pytest.approx(ref[key], rel=1e-10), key
     c = got["counts"]
-    assert c["factorizations"]["log"] == 0 and c["restorations"]["log"] == 1
+    assert c["factorizations"]["log"] == 0 and c["restorations"]["log"] == 2
+    # The flight after the contact on the Schur factor's full solves: the same answer.
+    log = own.logs.get(BASE_FINE_LOG)
+    solves = log.back_substitutions
+    log.flight_factor = None
+    schur = own.evaluate(BASE_FINE_LOG.replace(**asked))
+    assert log.back_substitutions - solves == ref["log_back_substitutions"]
+    for key in OUTPUTS:
+        assert schur[key] == pytest.approx(ref[key], rel=1e-10), key
+    # A format-3 model (no plain log factor) still loads, and its log flies that way.
+    mpath = path / "manifest.json"
+    now = mpath.read_text()
+    old = json.loads(now)
+    old["format"] = 3
+    del old["logs"][0]["flight_factor"]
+    mpath.write_text(json.dumps(old))
+    got3 = what_if_json(path, asked)
+    assert got3["counts"]["restorations"]["log"] == 1
+    for key in OUTPUTS:
+        assert got3["outputs"][key] == pytest.approx(ref[key], rel=1e-10), key
+    mpath.write_text(now)
     # A scenario of another log reads none of the large log's files.
     ev = model_file.load(path)
     ev.evaluate(BASE_FINE_LOG.replace(log_length_m=8.0))
     assert ev.counts()["restorations"].get("log", 0) == 0
-    assert ev.counts()["factorizations"]["log"] == 1
+    assert ev.counts()["factorizations"]["log"] == 2  # its Schur and its plain factor
     # Its files are hashed when read, not at every load: an altered arrays file is named
     # by the scenario that reads it, while another log's scenario still answers.
     arrays = path / entry["arrays"]

@@ -267,8 +267,7 @@ def _free_log_step(log, body):
     if b is None:
         return None
     y = log.new_vector()
-    log.factor.solve(b, y)
-    log.back_substitutions += 1
+    log.solve_free(b, y)
     b.destroy()
     return y
 

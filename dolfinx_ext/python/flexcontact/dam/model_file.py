@@ -10,8 +10,9 @@ The model is one directory, written atomically (complete or absent):
   functions (dam/response.py), the face compliance of the re-contact bound, the static
   displacement of each water level it was asked for, and the config's logs held dense
   (dense_factor.DENSE_LIMIT);
-* a larger log of the config: ``logN_arrays.npz`` (its K, M₁, front and W_front) and
-  MUMPS's files of its Schur factor on the front, read when a scenario first asks for it;
+* a larger log of the config: ``logN_arrays.npz`` (its K, M₁, front and W_front), and
+  MUMPS's files of its Schur factor on the front and of its plain factor (the flight after
+  the contact, dam/log_model.py), read when a scenario first asks for it;
 * MUMPS's own files of the two factors, K (stage 1: another water level in the range is one
   back-substitution) and Ŵ (stage 2, with its Schur complement on the face, so that a
   restored dam condenses and expands as the one that factored it), written and checked by
@@ -41,13 +42,14 @@ from .. import saved_factor
 from ..split_factor import SplitFactor
 from ..errors import SavedFileError
 
-MODEL_FORMAT = 3
+MODEL_FORMAT = 4
 """The model directory's format (2: a factor may be held in arrays.npz, "kind": "split";
-3: a large log kept as its own arrays file and MUMPS factor)."""
+3: a large log kept as its own arrays file and MUMPS factor; 4: and its plain factor)."""
 
-READABLE_FORMATS = (2, 3)
-"""Formats this flexcontact loads (a format-2 model holds no large log); any other is
-refused."""
+READABLE_FORMATS = (2, 3, 4)
+"""Formats this flexcontact loads (a format-2 model holds no large log; a format-3
+model's large log flies after the contact on its Schur factor, the same answer to
+round-off at three times the cost of a step); any other is refused."""
 
 SPLIT = "split"
 """The manifest's "kind" of a factor kept in arrays.npz (split_factor.SplitFactor)."""
@@ -186,7 +188,7 @@ def read_manifest(path, every_file: bool = False) -> dict:
     for name, want in manifest["files"].items():
         check_file(path / name, want, contents=every_file or name not in later)
     for entry in [*manifest["factors"].values(),
-                  *(e["factor"] for e in manifest.get("logs", []) if "factor" in e)]:
+                  *(e[k] for e in manifest.get("logs", []) for k in LOG_FACTORS if k in e)]:
         if entry.get("kind") != SPLIT:  # a split factor's arrays were checked above
             saved_factor.check_factor_files(path, entry, contents=every_file)
     return manifest
@@ -268,10 +270,15 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
     return ev
 
 
+LOG_FACTORS = ("factor", "flight_factor")
+"""A large log's factors in its manifest entry: the Schur factor on its front, and the
+plain factor of its flight after the contact (format 4)."""
+
+
 def _large_log(path: Path, entry: dict, want: dict):
-    """(LogMesh, restored Schur factor, W_front) of a log that the model keeps factored by
-    MUMPS: its own arrays file (checked against ``want``, its manifest entry) and factor
-    files, read when a scenario first asks for it."""
+    """(LogMesh, restored Schur factor, W_front, restored plain factor or None) of a log
+    that the model keeps factored by MUMPS: its own arrays file (checked against ``want``,
+    its manifest entry) and factor files, read when a scenario first asks for it."""
     from .log_model import LogMesh
     p = entry["prefix"]
     check_file(path / entry["arrays"], want)
@@ -280,7 +287,9 @@ def _large_log(path: Path, entry: dict, want: dict):
     mesh = LogMesh.from_arrays(arrays, p)
     W_front = arrays[p + "W_front"]
     factor = saved_factor.restore_factor(path, entry["factor"], mesh.front_dofs, W_front)
-    return mesh, factor, W_front
+    flight = (saved_factor.restore_factor(path, entry["flight_factor"])
+              if "flight_factor" in entry else None)
+    return mesh, factor, W_front, flight
 
 
 MAX_LOGS = 16
@@ -321,6 +330,8 @@ def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> tuple[list, int]
             np.savez(folder / entry["arrays"], **log.mesh.arrays(p),
                      **{p + "W_front": log.W_front})
             entry["factor"] = saved_factor.save_factor(log.factor, folder, p + "factor")
+            entry["flight_factor"] = saved_factor.save_factor(log.flight_factor, folder,
+                                                              p + "flight")
             entry["ball"] = None if log.mesh.ball is None else list(log.mesh.ball)
         entries.append(entry)
     return entries, sum(m.factorizations for m in cache.models.values())

@@ -86,9 +86,9 @@ class LogCache:
         key = log_key(s)
         if key not in self.models and key in self.saved:
             saved_s, load = self.saved.pop(key)
-            mesh, factor, W_front = load()
+            mesh, factor, W_front, flight = load()
             self.meshes.setdefault(self._mesh_key(saved_s), mesh)
-            self.models[key] = self._model(saved_s, mesh, factor, W_front)
+            self.models[key] = self._model(saved_s, mesh, factor, W_front, flight)
         if key not in self.models:
             mesh_key = self._mesh_key(s)
             if mesh_key not in self.meshes:
@@ -113,18 +113,19 @@ class LogCache:
     def restore_later(self, s: DamScenario, ball, load) -> None:
         """Adopt the log of scenario ``s`` that a model file holds factored by MUMPS (a large
         log): ``load()`` returns (its LogMesh without a mesh, its restored Schur factor,
-        W_front) and is called when the log is first asked for, so that a scenario of
-        another log reads none of its files. ``ball``: the contact ball it was meshed
-        with (the same rule as :meth:`restore`)."""
+        W_front, its restored plain factor or None) and is called when the log is first
+        asked for, so that a scenario of another log reads none of its files. ``ball``:
+        the contact ball it was meshed with (the same rule as :meth:`restore`)."""
         if ball != contact_ball(s):
             return
         self.saved[log_key(s)] = (s, load)
 
-    def _model(self, s: DamScenario, mesh, factor=None, W_front=None) -> LogModel:
+    def _model(self, s: DamScenario, mesh, factor=None, W_front=None,
+               flight=None) -> LogModel:
         return LogModel(
             s.log_length_m, s.log_diameter_m, s.wood.rho_kg_m3 * (1 + s.added_mass_coefficient),
             s.wood.E_Pa, s.wood.nu, self.dt, h_m=s.h_log_m, theta=self.theta, comm=self.comm,
-            mesh=mesh, dim=s.dim, factor=factor, W_front=W_front)
+            mesh=mesh, dim=s.dim, factor=factor, W_front=W_front, flight_factor=flight)
 
     def setup_s(self) -> float:
         """Seconds of meshing, factorization and condensation of every log so far."""
