@@ -23,15 +23,17 @@ namespace
 /// relative residual then mistakes for convergence. Beyond a size where a rank-revealing
 /// factorisation is too slow, a Tikhonov-regularised LU is the fallback. Returns false if
 /// no finite solution was found.
+bool lu_solve(const Matrix& A, const Vector& b, Vector& x)
+{
+  Eigen::PartialPivLU<Matrix> lu(A);
+  x = lu.solve(b);
+  return x.allFinite() && (A * x - b).norm() <= 1e-8 * std::max(b.norm(), 1e-300);
+}
+
 bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
 {
-  const double bn = b.norm();
-  {
-    Eigen::PartialPivLU<Matrix> lu(A);
-    x = lu.solve(b);
-    if (x.allFinite() && (A * x - b).norm() <= 1e-8 * std::max(bn, 1e-300))
-      return true;
-  }
+  if (lu_solve(A, b, x))
+    return true;
   if (A.rows() <= 1500)
   {
     Eigen::CompleteOrthogonalDecomposition<Matrix> cod(A);
@@ -43,6 +45,28 @@ bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
   Matrix R = A;
   R.diagonal().array() += 1e-8 * scale;
   x = Eigen::PartialPivLU<Matrix>(R).solve(b);
+  return x.allFinite();
+}
+
+/// @brief A x = b by the LU of the rows keep only, the others being the identity's (x = b
+/// there). False if that LU fails.
+bool reduced_solve(const Matrix& A, const Vector& b, const std::vector<Eigen::Index>& keep,
+                   Vector& x)
+{
+  std::vector<Eigen::Index> fixed;
+  for (Eigen::Index i = 0, j = 0; i < A.rows(); ++i)
+    if (j < static_cast<Eigen::Index>(keep.size()) && keep[static_cast<std::size_t>(j)] == i)
+      ++j;
+    else
+      fixed.push_back(i);
+  x = b;
+  if (!keep.empty())
+  {
+    Vector xk;
+    if (!lu_solve(A(keep, keep), b(keep) - A(keep, fixed) * b(fixed), xk))
+      return false;
+    x(keep) = xk;
+  }
   return x.allFinite();
 }
 
@@ -96,9 +120,28 @@ double merit(const ProblemView& p, const Vector& rho, const Vector& rho_t, const
   return 0.5 * phi.squaredNorm();
 }
 
+namespace
+{
+/// @brief The rows of the closed pairs' Newton block (local indices a·d + i, ascending) whose
+/// row of ∂P/∂z is not zero.
+void solved_rows(const std::vector<double>& dP, const std::vector<int>& closed, int d,
+                 std::vector<Eigen::Index>& keep)
+{
+  keep.clear();
+  for (std::size_t a = 0; a < closed.size(); ++a)
+  {
+    const DpBlock D = dp_block(dP, closed[a], d);
+    for (int i = 0; i < d; ++i)
+      if ((D.row(i).array() != 0.0).any())
+        keep.push_back(static_cast<Eigen::Index>(a) * d + i);
+  }
+}
+} // namespace
+
 bool newton_direction(const ProblemView& p, const Vector& rho, const Vector& rho_t,
                       const Vector& phi, const std::vector<double>& dP,
-                      const std::vector<int>& closed, Vector& dl)
+                      const std::vector<int>& closed, Vector& dl,
+                      std::vector<double>* factorised)
 {
   const int d = p.dim;
   dl = -phi;
@@ -123,9 +166,29 @@ bool newton_direction(const ProblemView& p, const Vector& rho, const Vector& rho
     A.block(a * d, a * d, d, d) += Matrix::Identity(d, d) - dp_block(dP, k, d);
     b.segment(a * d, d) = -phi.segment(k * d, d) - Dr * Wd0.segment(k * d, d);
   }
+  // A row of ∂P/∂z that is zero (a normal impulse at its cap, a frictionless tangent) makes
+  // that row of A the identity's and of b −Φ: x = b there, as on an open pair, and its
+  // column moves to the right-hand side. Only the other rows are factorised: at a crushing
+  // front, where every closed pair sits at its cap, two thirds of them in 3D. A block whose
+  // reduced LU fails is solved whole, as before: on a singular, inconsistent block the
+  // least-squares step of all rows is not the one that holds the identity rows exactly.
+  std::vector<Eigen::Index> keep;
+  solved_rows(dP, closed, d, keep);
+  const auto took = [&](Eigen::Index order)
+  {
+    if (factorised)
+      factorised->push_back(static_cast<double>(order));
+  };
   Vector x;
-  if (!linear_solve(A, b, x))
-    return false;
+  const bool reduced = static_cast<Eigen::Index>(keep.size()) < A.rows();
+  if (reduced)
+    took(static_cast<Eigen::Index>(keep.size()));
+  if (!(reduced && reduced_solve(A, b, keep, x)))
+  {
+    took(A.rows());
+    if (!linear_solve(A, b, x))
+      return false;
+  }
   for (int a = 0; a < nc; ++a)
     dl.segment(closed[a] * d, d) = x.segment(a * d, d);
   return true;

@@ -43,10 +43,14 @@ double merit(const ProblemView& p, const Vector& rho, const Vector& rho_t, const
 /// @brief Newton direction dl from the generalised Jacobian, J Δ = −Φ with
 /// J = I − D (I − ρW) = (I − D) + D ρ W, D = blockdiag(∂P/∂z). Pairs with D_k = 0 (open)
 /// have identity rows: Δ_k = −Φ_k; only the closed block is factorised, which keeps the
-/// dense LU to the size of the contact zone. Returns false if that block has no solution.
+/// dense LU to the size of the contact zone, and within it only the rows whose row of
+/// ∂P/∂z is not zero (the others are the identity's too). Returns false if that block has
+/// no solution. ``factorised``: the orders of the LUs taken (the reduced block's, and the
+/// whole block's where the reduced LU failed), for the work budget.
 bool newton_direction(const ProblemView& p, const Vector& rho, const Vector& rho_t,
                       const Vector& phi, const std::vector<double>& dP,
-                      const std::vector<int>& closed, Vector& dl);
+                      const std::vector<int>& closed, Vector& dl,
+                      std::vector<double>* factorised = nullptr);
 
 /// @brief Non-monotone reference of the line search: the largest merit of the last few
 /// accepted iterates lets the iteration pass the shallow ridges the kinks of Φ create

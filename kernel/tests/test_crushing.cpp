@@ -231,3 +231,36 @@ TEST(CrushDepth, BadCapsNamed)
   EXPECT_NE(message_of([&] { s.set_crushing(vec({1.0}), vec({-1.0})); }).find("crush depth"),
             std::string::npos);
 }
+
+TEST(CrushingSolvers, NewtonFactorisesOnlyTheRowsNotHeldAtTheirCap)
+{
+  // Every pair at its cap and sticking: the normal rows of ∂P/∂z are zero, so a Newton step
+  // fixes the normals and solves the tangential rows alone, 2m of the 3m, exactly (they are
+  // linear there). From the answer with its tangents moved, one step lands on it, and the
+  // work charged is the LU of order 2m, not 3m.
+  const int d = 3, m = 12, n = m * d;
+  const Matrix W = random_spd(n, 1e2, 7);
+  Vector lam(n), u = Vector::Zero(n), mu = Vector::Constant(m, 0.5), cap(m);
+  for (int k = 0; k < m; ++k)
+  {
+    cap[k] = 0.5 + 0.05 * k;
+    lam[k * d] = cap[k];
+    lam[k * d + 1] = 0.1 * cap[k] * std::cos(k);
+    lam[k * d + 2] = 0.1 * cap[k] * std::sin(k);
+    u[k * d] = -0.1; // pressed past the cap: it crushes
+  }
+  const Vector q = u - W * lam;
+  const ProblemView p{d, W, q, mu, cap.data()};
+  Vector start = lam;
+  for (int k = 0; k < m; ++k)
+    start[k * d + 1] += 0.01 * cap[k];
+  const SolveReport r = solve_newton_ac(p, start, SolverOptions{});
+  ASSERT_TRUE(r.converged) << r.attempts.back();
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_LE((r.lambda - lam).cwiseAbs().maxCoeff(), 1e-12);
+  for (int k = 0; k < m; ++k)
+    EXPECT_EQ(r.states[k], PairState::crush) << "pair " << k;
+  const double s = n, solved = 2 * m;
+  const double flops = 2.0 * 2.0 * n * n + 2.0 * d * s * s + 2.0 / 3.0 * solved * solved * solved;
+  EXPECT_NEAR(r.work_gflop, flops * 1e-9, 1e-12 * flops * 1e-9);
+}
