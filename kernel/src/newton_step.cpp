@@ -17,12 +17,8 @@ namespace flexcontact::detail
 {
 namespace
 {
-/// @brief Solve A x = b, pivoted LU first. A singular A (semi-definite W, fully constrained
-/// pairs) gets the minimum-norm least-squares step instead: it moves nothing along the null
-/// space, where an LU or a small regularisation would send λ off to huge values that the
-/// relative residual then mistakes for convergence. Beyond a size where a rank-revealing
-/// factorisation is too slow, a Tikhonov-regularised LU is the fallback. Returns false if
-/// no finite solution was found.
+/// @brief A x = b by a pivoted LU; false unless x is finite and its residual within 1e-8
+/// of ‖b‖.
 bool lu_solve(const Matrix& A, const Vector& b, Vector& x)
 {
   Eigen::PartialPivLU<Matrix> lu(A);
@@ -30,6 +26,12 @@ bool lu_solve(const Matrix& A, const Vector& b, Vector& x)
   return x.allFinite() && (A * x - b).norm() <= 1e-8 * std::max(b.norm(), 1e-300);
 }
 
+/// @brief Solve A x = b, pivoted LU first. A singular A (semi-definite W, fully constrained
+/// pairs) gets the minimum-norm least-squares step instead: it moves nothing along the null
+/// space, where an LU or a small regularisation would send λ off to huge values that the
+/// relative residual then mistakes for convergence. Beyond a size where a rank-revealing
+/// factorisation is too slow, a Tikhonov-regularised LU is the fallback. Returns false if
+/// no finite solution was found.
 bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
 {
   if (lu_solve(A, b, x))
