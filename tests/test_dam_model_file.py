@@ -201,6 +201,7 @@ def test_a_large_log_is_kept_and_restored_when_asked(tmp_path):
     c = got["counts"]
     assert c["factorizations"]["log"] == 0 and c["restorations"]["log"] == 2
     # The flight after the contact on the Schur factor's full solves: the same answer.
+    assert ref["dam_steps_convolved"] > 0  # the log flew alone after the contact
     log = own.logs.get(BASE_FINE_LOG)
     solves = log.back_substitutions
     log.flight_factor = None
