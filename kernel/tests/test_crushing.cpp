@@ -236,31 +236,36 @@ TEST(CrushingSolvers, NewtonFactorisesOnlyTheRowsNotHeldAtTheirCap)
 {
   // Every pair at its cap and sticking: the normal rows of ∂P/∂z are zero, so a Newton step
   // fixes the normals and solves the tangential rows alone, 2m of the 3m, exactly (they are
-  // linear there). From the answer with its tangents moved, one step lands on it, and the
-  // work charged is the LU of order 2m, not 3m.
-  const int d = 3, m = 12, n = m * d;
-  const Matrix W = random_spd(n, 1e2, 7);
-  Vector lam(n), u = Vector::Zero(n), mu = Vector::Constant(m, 0.5), cap(m);
-  for (int k = 0; k < m; ++k)
+  // linear there). From the answer with its tangents moved, one step lands on it. The work
+  // charged is the LU of order 2m for a block of 300 rows or more (3m = 330 here), and of
+  // the whole block below (3m = 36), which keeps its LU (newton_step.cpp).
+  const int d = 3;
+  for (const int m : {110, 12})
   {
-    cap[k] = 0.5 + 0.05 * k;
-    lam[k * d] = cap[k];
-    lam[k * d + 1] = 0.1 * cap[k] * std::cos(k);
-    lam[k * d + 2] = 0.1 * cap[k] * std::sin(k);
-    u[k * d] = -0.1; // pressed past the cap: it crushes
+    const int n = m * d;
+    const Matrix W = random_spd(n, 1e2, 7);
+    Vector lam(n), u = Vector::Zero(n), mu = Vector::Constant(m, 0.5), cap(m);
+    for (int k = 0; k < m; ++k)
+    {
+      cap[k] = 0.5 + 0.05 * k;
+      lam[k * d] = cap[k];
+      lam[k * d + 1] = 0.1 * cap[k] * std::cos(k);
+      lam[k * d + 2] = 0.1 * cap[k] * std::sin(k);
+      u[k * d] = -0.1; // pressed past the cap: it crushes
+    }
+    const Vector q = u - W * lam;
+    const ProblemView p{d, W, q, mu, cap.data()};
+    Vector start = lam;
+    for (int k = 0; k < m; ++k)
+      start[k * d + 1] += 0.01 * cap[k];
+    const SolveReport r = solve_newton_ac(p, start, SolverOptions{});
+    ASSERT_TRUE(r.converged) << m << " pairs: " << r.attempts.back();
+    EXPECT_EQ(r.iterations, 1) << m << " pairs";
+    EXPECT_LE((r.lambda - lam).cwiseAbs().maxCoeff(), 1e-12) << m << " pairs";
+    for (int k = 0; k < m; ++k)
+      EXPECT_EQ(r.states[k], PairState::crush) << m << " pairs, pair " << k;
+    const double s = n, lu = n >= 300 ? 2.0 * m : n;
+    const double flops = 2.0 * 2.0 * s * s + 2.0 * d * s * s + 2.0 / 3.0 * lu * lu * lu;
+    EXPECT_NEAR(r.work_gflop, flops * 1e-9, 1e-12 * flops * 1e-9) << m << " pairs";
   }
-  const Vector q = u - W * lam;
-  const ProblemView p{d, W, q, mu, cap.data()};
-  Vector start = lam;
-  for (int k = 0; k < m; ++k)
-    start[k * d + 1] += 0.01 * cap[k];
-  const SolveReport r = solve_newton_ac(p, start, SolverOptions{});
-  ASSERT_TRUE(r.converged) << r.attempts.back();
-  EXPECT_EQ(r.iterations, 1);
-  EXPECT_LE((r.lambda - lam).cwiseAbs().maxCoeff(), 1e-12);
-  for (int k = 0; k < m; ++k)
-    EXPECT_EQ(r.states[k], PairState::crush) << "pair " << k;
-  const double s = n, solved = 2 * m;
-  const double flops = 2.0 * 2.0 * n * n + 2.0 * d * s * s + 2.0 / 3.0 * solved * solved * solved;
-  EXPECT_NEAR(r.work_gflop, flops * 1e-9, 1e-12 * flops * 1e-9);
 }
