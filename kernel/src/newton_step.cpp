@@ -50,17 +50,11 @@ bool linear_solve(const Matrix& A, const Vector& b, Vector& x)
   return x.allFinite();
 }
 
-/// @brief A x = b by the LU of the rows keep only, the others being the identity's (x = b
+/// @brief A x = b by the LU of the rows keep only, the rows fixed being the identity's (x = b
 /// there). False if that LU fails.
 bool reduced_solve(const Matrix& A, const Vector& b, const std::vector<Eigen::Index>& keep,
-                   Vector& x)
+                   const std::vector<Eigen::Index>& fixed, Vector& x)
 {
-  std::vector<Eigen::Index> fixed;
-  for (Eigen::Index i = 0, j = 0; i < A.rows(); ++i)
-    if (j < static_cast<Eigen::Index>(keep.size()) && keep[static_cast<std::size_t>(j)] == i)
-      ++j;
-    else
-      fixed.push_back(i);
   x = b;
   if (!keep.empty())
   {
@@ -125,17 +119,16 @@ double merit(const ProblemView& p, const Vector& rho, const Vector& rho_t, const
 namespace
 {
 /// @brief The rows of the closed pairs' Newton block (local indices a·d + i, ascending) whose
-/// row of ∂P/∂z is not zero.
-void solved_rows(const std::vector<double>& dP, const std::vector<int>& closed, int d,
-                 std::vector<Eigen::Index>& keep)
+/// row of ∂P/∂z is not zero (keep), and the others (fixed).
+void split_rows(const std::vector<double>& dP, const std::vector<int>& closed, int d,
+                std::vector<Eigen::Index>& keep, std::vector<Eigen::Index>& fixed)
 {
-  keep.clear();
   for (std::size_t a = 0; a < closed.size(); ++a)
   {
     const DpBlock D = dp_block(dP, closed[a], d);
     for (int i = 0; i < d; ++i)
-      if ((D.row(i).array() != 0.0).any())
-        keep.push_back(static_cast<Eigen::Index>(a) * d + i);
+      ((D.row(i).array() != 0.0).any() ? keep : fixed)
+          .push_back(static_cast<Eigen::Index>(a) * d + i);
   }
 }
 } // namespace
@@ -179,22 +172,19 @@ bool newton_direction(const ProblemView& p, const Vector& rho, const Vector& rho
   // path, and one of the hard test problems (ill_conditioned-3d-m36-3407, 108 unknowns)
   // was then lost by the build of one stack.
   constexpr Eigen::Index reduce_from_rows = 300;
-  std::vector<Eigen::Index> keep;
+  std::vector<Eigen::Index> keep, fixed;
   if (A.rows() >= reduce_from_rows)
-    solved_rows(dP, closed, d, keep);
-  else
-    for (Eigen::Index i = 0; i < A.rows(); ++i)
-      keep.push_back(i);
+    split_rows(dP, closed, d, keep, fixed);
   const auto took = [&](Eigen::Index order)
   {
     if (factorised)
       factorised->push_back(static_cast<double>(order));
   };
   Vector x;
-  const bool reduced = static_cast<Eigen::Index>(keep.size()) < A.rows();
+  const bool reduced = !fixed.empty();
   if (reduced)
     took(static_cast<Eigen::Index>(keep.size()));
-  if (!(reduced && reduced_solve(A, b, keep, x)))
+  if (!(reduced && reduced_solve(A, b, keep, fixed, x)))
   {
     took(A.rows());
     if (!linear_solve(A, b, x))
