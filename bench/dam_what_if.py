@@ -69,36 +69,37 @@ with tempfile.TemporaryDirectory() as tmp:
     prepare_s = time.perf_counter() - t0
     size = sum(p.stat().st_size for p in model.iterdir())
     bare = None
+
+    def variant(name: str, leave_out: set, manifest: dict) -> Path:
+        """A model beside ``model`` with its files (hard links) but ``leave_out``, and
+        ``manifest``."""
+        folder = Path(tmp) / name
+        folder.mkdir()
+        for p in model.iterdir():
+            if p.name not in leave_out and p.name != "manifest.json":
+                os.link(p, folder / p.name)
+        (folder / "manifest.json").write_text(json.dumps(manifest))
+        return folder
+
+    manifest = json.loads((model / "manifest.json").read_text())
     if args.ab_saved_logs:
         # The same dam files, no log: a valid model whose what-if builds its log.
-        bare = Path(tmp) / "model_without_logs"
-        bare.mkdir()
-        manifest = json.loads((model / "manifest.json").read_text())
         if any(e.get("arrays") is None for e in manifest["logs"]):
             sys.exit("--ab-saved-logs: a log held dense sits in arrays.npz; this compares "
                      "large logs only")
         log_files = {f for e in manifest["logs"]
                      for f in [e["arrays"], *e["factor"]["files"],
                                *e.get("flight_factor", {}).get("files", [])]}
-        for p in model.iterdir():
-            if p.name not in log_files and p.name != "manifest.json":
-                os.link(p, bare / p.name)
         manifest["files"] = {k: v for k, v in manifest["files"].items() if k not in log_files}
         manifest["logs"] = []
-        (bare / "manifest.json").write_text(json.dumps(manifest))
+        bare = variant("model_without_logs", log_files, manifest)
     if args.ab_flight:
         # The same files, read as format 3: the large logs lose their plain factor.
-        bare = Path(tmp) / "model_format_3"
-        bare.mkdir()
-        manifest = json.loads((model / "manifest.json").read_text())
         flight = {f for e in manifest["logs"] for f in e.pop("flight_factor", {}).get("files", [])}
         if not flight:
             sys.exit("--ab-flight: the model has no large log")
-        for p in model.iterdir():
-            if p.name not in flight and p.name != "manifest.json":
-                os.link(p, bare / p.name)
         manifest["format"] = 3
-        (bare / "manifest.json").write_text(json.dumps(manifest))
+        bare = variant("model_format_3", flight, manifest)
 
     def what_if(path):
         t0 = time.perf_counter()
