@@ -50,7 +50,7 @@ from ..meshes import dam_tags as T
 from ..pairing import _candidate_surface
 from ..split_factor import SplitFactor
 from .section import BaseSection
-from .stress_probe import RecoveredStressProbe
+from .stress_probe import ProbeSpace, RecoveredStressProbe
 from .stage1 import DamMesh, _measures, _sections, body_loads
 from .stage2 import stage2_supports
 from ..errors import InputError, SolveError
@@ -181,6 +181,7 @@ class DamModel:
         self._stage2()
         self._heel_functional()
         self._u_total = dolfinx.fem.Function(self.V)   # u_static + w, read by stress probes
+        self._probe_space = None                       # shared by the stress probes
         self.timings["setup_s"] = time.perf_counter() - t0
 
     # ---- stage 1 -------------------------------------------------------------------------
@@ -397,8 +398,11 @@ class DamModel:
         """The recovered largest principal stress of u_static + w at ``offset_m`` from
         ``point_m`` in the dam (see :class:`RecoveredStressProbe`), for
         :meth:`peak_principal_Pa`."""
+        if self._probe_space is None:
+            self._probe_space = ProbeSpace(self.mesh.msh, self.mesh.cell_tags, self.materials,
+                                           self.kind, T.DAM)
         return RecoveredStressProbe(self._u_total, self.mesh.cell_tags, self.materials,
-                                    self.kind, point_m, offset_m, T.DAM)
+                                    self.kind, point_m, offset_m, T.DAM, space=self._probe_space)
 
     def peak_principal_Pa(self, static: StaticState, w: PETSc.Vec,
                           probe: RecoveredStressProbe) -> float:

@@ -31,6 +31,23 @@ PATCH = 1
 _COMPONENTS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
+class ProbeSpace:
+    """What every probe on one mesh, material map, stress kind and tag shares: the Lamé
+    fields, the recovered stress's space and the lumped mass over the whole tag. A dam
+    model reads a new probe for each scenario's impact point."""
+
+    def __init__(self, msh, cell_tags, materials: dict, kind: str, tag: int):
+        self.lame = lame_fields(msh, cell_tags, materials)
+        self.comps = _COMPONENTS if kind == "3d" else _COMPONENTS[:4]
+        self.V = compat.vector_space(msh, 1, len(self.comps))
+        self.tau = ufl.TestFunction(self.V)
+        self.ones = ufl.as_vector([1.0] * len(self.comps))
+        self.m = compat.create_petsc_vector(self.V)
+        self.full = _assembled(dolfinx.fem.form(
+            ufl.inner(self.ones, self.tau)
+            * ufl.Measure("dx", domain=msh, subdomain_data=cell_tags)(tag)), self.m)
+
+
 class RecoveredStressProbe:
     """Peak of the recovered largest principal stress (Pa, tension positive) over the
     samples of an :class:`~flexcontact.dam.section.OffsetProbe` (a circle in 2D, a sphere in
@@ -38,48 +55,87 @@ class RecoveredStressProbe:
 
     The nodal stress is Σ_c |c| σ_c / Σ_c |c| over the cells c tagged ``tag`` around the
     node, so a material interface is not smeared; a constant stress is recovered exactly.
-    Only a shell of cells around the sphere is assembled at each call: the shell grows until
-    every node of a sample cell has all its cells in it (checked against the full lumped
-    mass, so a partition boundary cannot cut a node's average short). ``u`` is read at each
-    :meth:`peak`; ``kind`` as for the stress forms. Collective, as is :meth:`peak`.
+    Only a shell of cells around the sphere counts: it grows until every node of a sample
+    cell has all its cells in it (checked against the full lumped mass, so a partition
+    boundary cannot cut a node's average short). ``u`` is read at each
+    :meth:`peak`; ``kind`` as for the stress forms. ``space``: a :class:`ProbeSpace` built
+    for the same mesh, tags, materials, kind and tag, shared between probes. In serial a
+    reading is a fixed sparse map of ``u`` (built here); on several ranks the shell is
+    assembled at each reading. Collective, as is :meth:`peak`.
     """
 
     def __init__(self, u, cell_tags, materials: dict, kind: str, point, offset_m: float,
-                 tag: int, samples: int = 720):
+                 tag: int, samples: int = 720, space: "ProbeSpace | None" = None):
         msh = u.function_space.mesh
+        if space is None:
+            space = ProbeSpace(msh, cell_tags, materials, kind, tag)
         self.offset = OffsetProbe(msh, point, offset_m, cell_tags, tag, samples)
         self.comm = msh.comm
-        s = stress_3x3(u, lame_fields(msh, cell_tags, materials), kind)
-        comps = _COMPONENTS if kind == "3d" else _COMPONENTS[:4]
-        V = compat.vector_space(msh, 1, len(comps))
-        tau = ufl.TestFunction(V)
-        ones = ufl.as_vector([1.0] * len(comps))
-        self._rec = dolfinx.fem.Function(V)
-        self._b = compat.create_petsc_vector(V)
-        self._m = compat.create_petsc_vector(V)
+        lame, comps, V, tau, ones = space.lame, space.comps, space.V, space.tau, space.ones
+        self._u = u
+        self._m = space.m
         self._ncomp = len(comps)
-        full = self._assemble(dolfinx.fem.form(
-            ufl.inner(ones, tau) * ufl.Measure("dx", domain=msh, subdomain_data=cell_tags)(tag)),
-            self._m)
+        full = space.full
         needed = np.unique(compat.cell_dofs(V)[self.offset.cells].reshape(-1))
         patch, self._mass = self._patch(msh, cell_tags, tag, np.asarray(point, float),
                                         float(offset_m), ones, tau, full, needed,
                                         V.dofmap.index_map_bs)
         dxp = ufl.Measure("dx", domain=msh, subdomain_data=patch)(PATCH)
-        self._form = dolfinx.fem.form(
-            ufl.inner(ufl.as_vector([s[i, j] for i, j in comps]), tau) * dxp)
         self._comps = comps
+        self._linear = (self._operator(u, lame, kind, V, tau, dxp) if self.comm.size == 1
+                        else None)
+        if self._linear is None:
+            self._rec = dolfinx.fem.Function(V)
+            self._b = compat.create_petsc_vector(V)
+            s = stress_3x3(u, lame, kind)
+            self._form = dolfinx.fem.form(
+                ufl.inner(ufl.as_vector([s[i, j] for i, j in comps]), tau) * dxp)
         self.patch_cells = int(self.comm.allreduce(
             np.count_nonzero(patch.indices < _owned_cells(msh)), op=MPI.SUM))
 
-    def _assemble(self, form, vec) -> np.ndarray:
-        with vec.localForm() as loc:
-            loc.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(vec, form)
-        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        with vec.localForm() as loc:
-            return loc.array.copy()
+    def _operator(self, u, lame, kind, V, tau, dxp):
+        """(R, E) in serial: the recovered stress components at the sample cells' nodes are
+        R u (the patch's stress form over the lumped mass), and at the samples E R u (their
+        linear interpolation). Both are sparse and fixed, so a reading is two small products
+        instead of an assembly and a point evaluation (a sweep reads the probe at every
+        contact step of every scenario). None on cells other than simplices, whose
+        interpolation is not barycentric."""
+        import scipy.sparse
+        gdim = u.function_space.mesh.geometry.dim
+        if compat.cell_dofs(V).shape[1] != gdim + 1:
+            return None
+        du = ufl.TrialFunction(u.function_space)
+        s = stress_3x3(du, lame, kind)
+        A = compat.assemble_matrix(dolfinx.fem.form(
+            ufl.inner(ufl.as_vector([s[i, j] for i, j in self._comps]), tau) * dxp), [])
+        ai, aj, av = A.getValuesCSR()
+        shape = A.getSize()
+        A.destroy()
+        nc = self._ncomp
+        found = self.offset.found
+        if len(found) == 0:
+            return (scipy.sparse.csr_matrix((0, shape[1])), scipy.sparse.csr_matrix((0, 0)))
+        blocks = compat.cell_dofs(V)[self.offset.sample_cells]            # (k, vertices)
+        node_blocks, local = np.unique(blocks, return_inverse=True)
+        local = local.reshape(blocks.shape)
+        rows = (node_blocks[:, None] * nc + np.arange(nc)).reshape(-1)
+        mass = self._mass[rows]
+        scale = np.divide(1.0, mass, out=np.zeros_like(mass), where=mass > 0)
+        R = scipy.sparse.diags(scale) @ scipy.sparse.csr_matrix((av, aj, ai), shape=shape)[rows]
+        # Barycentric coordinates of each sample in its (affine, linear) cell.
+        X = V.tabulate_dof_coordinates()[blocks][:, :, :gdim]
+        p = self.offset.points[found][:, :gdim]
+        edges = (X[:, 1:] - X[:, :1]).transpose(0, 2, 1)
+        tail = np.linalg.solve(edges, (p - X[:, 0])[..., None])[..., 0]
+        lam = np.column_stack([1.0 - tail.sum(axis=1), tail])
+        k, nv = blocks.shape
+        E = scipy.sparse.csr_matrix((
+            np.repeat(lam, nc, axis=1).reshape(-1),
+            ((np.arange(k)[:, None, None] * nc + np.arange(nc)[None, None, :])
+             .repeat(nv, axis=1).reshape(-1),
+             (local[:, :, None] * nc + np.arange(nc)[None, None, :]).reshape(-1))),
+            shape=(k * nc, node_blocks.size * nc))
+        return R.tocsr(), E
 
     def _patch(self, msh, cell_tags, tag, point, offset_m, ones, tau, full, needed, bs):
         """(MeshTags of the shell of cells tagged ``tag`` whose midpoints lie within a
@@ -102,7 +158,7 @@ class RecoveredStressProbe:
         for _ in range(64):
             cells = np.flatnonzero(tagged & (dist <= margin)).astype(np.int32)
             patch = dolfinx.mesh.meshtags(msh, tdim, cells, np.full(cells.size, PATCH, np.int32))
-            got = self._assemble(dolfinx.fem.form(
+            got = _assembled(dolfinx.fem.form(
                 ufl.inner(ones, tau) * ufl.Measure("dx", domain=msh, subdomain_data=patch)(PATCH)),
                 self._m)
             short = bool(np.any(got[rows] < full[rows] * (1.0 - 1e-10)))
@@ -115,6 +171,11 @@ class RecoveredStressProbe:
     def peak(self):
         """(largest recovered principal stress over the samples in Pa, its sample point);
         (nan, None) if no sample lies in the tagged cells."""
+        if self._linear is not None and self._ncomp == 4:
+            # Plane strain: σ_zz is a principal stress, the in-plane pair is in closed form.
+            xx, yy, zz, xy = self._components().T
+            return self.offset.best(np.maximum(0.5 * (xx + yy) + np.hypot(0.5 * (xx - yy), xy),
+                                               zz))
         t = self._tensors()
         return self.offset.best(np.linalg.eigvalsh(t)[:, -1] if len(t) else np.zeros(0))
 
@@ -136,17 +197,38 @@ class RecoveredStressProbe:
 
     def _tensors(self) -> np.ndarray:
         """The recovered stress (k, 3, 3) at this rank's found samples."""
-        b = self._assemble(self._form, self._b)
+        c = self._components()   # collective on several ranks, samples here or not
+        t = np.zeros((len(c), 3, 3))
+        for k, (i, j) in enumerate(self._comps):
+            t[:, i, j] = t[:, j, i] = c[:, k]
+        return t
+
+    def _components(self) -> np.ndarray:
+        """The recovered stress components (k, ncomp) at this rank's found samples
+        (collective on several ranks)."""
+        if self._linear is not None:
+            R, E = self._linear
+            return (E @ (R @ self._u.x.array)).reshape(-1, self._ncomp)
+        b = _assembled(self._form, self._b)
         with np.errstate(divide="ignore", invalid="ignore"):
             self._rec.x.array[:] = np.where(self._mass > 0, b / self._mass, 0.0)
         found = self.offset.found
-        t = np.zeros((len(found), 3, 3))
-        if len(found):
-            c = self._rec.eval(self.offset.points[found], self.offset.sample_cells)
-            c = np.asarray(c).reshape(len(found), self._ncomp)
-            for k, (i, j) in enumerate(self._comps):
-                t[:, i, j] = t[:, j, i] = c[:, k]
-        return t
+        if not len(found):
+            return np.zeros((0, self._ncomp))
+        c = self._rec.eval(self.offset.points[found], self.offset.sample_cells)
+        return np.asarray(c).reshape(len(found), self._ncomp)
+
+
+def _assembled(form, vec) -> np.ndarray:
+    """The linear ``form`` assembled into ``vec``, ghosts summed and updated: a copy of the
+    local array."""
+    with vec.localForm() as loc:
+        loc.set(0.0)
+    dolfinx.fem.petsc.assemble_vector(vec, form)
+    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    vec.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    with vec.localForm() as loc:
+        return loc.array.copy()
 
 
 def _owned_cells(msh) -> int:
