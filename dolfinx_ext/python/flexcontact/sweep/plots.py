@@ -18,6 +18,15 @@ def _plt():
     return plt
 
 
+def _margins(fig, top_in: float = 0.4, hspace: float = 0.2) -> None:
+    """Fixed margins in inches, room for the tick and axis labels and the title: what
+    tight_layout found, without the extra draw of every axis it costs (a third of a
+    sweep's report time)."""
+    w, h = fig.get_size_inches()
+    fig.subplots_adjust(left=0.7 / w, right=1.0 - 0.15 / w, bottom=0.5 / h,
+                        top=1.0 - top_in / h, wspace=0.08, hspace=hspace)
+
+
 def envelope(x: np.ndarray, y: np.ndarray, bins: int = 10):
     """Upper envelope of y against x: the max per distinct x (a grid axis of few values)
     or per equal-count bin of x (a sample), at the bins' mean x."""
@@ -64,7 +73,7 @@ def envelope_plots(folder: Path, rows: list, inputs: list, outputs: list,
             row[0].set_ylabel(qo.label())
         axes[0][0].legend(fontsize=7)
         fig.suptitle(f"{qo.words}: every scenario and the upper envelope", fontsize=9)
-        fig.tight_layout()
+        _margins(fig, hspace=0.45)
         path = folder / f"envelope_{o}.png"
         fig.savefig(path, dpi=110)
         plt.close(fig)
@@ -98,7 +107,7 @@ def exceedance_plot(folder: Path, output: str, curve: dict, dim: int = 2) -> Pat
     ax.set_ylabel("P[X > x | impact]")
     ax.set_title(f"{q.words}: exceedance\n({CONDITIONAL})", fontsize=8)
     ax.legend(fontsize=7, loc="upper right")
-    fig.tight_layout()
+    _margins(fig, top_in=0.55)
     path = folder / f"exceedance_{output}.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
