@@ -170,6 +170,36 @@ def test_a_3d_model_answers_in_a_new_process_as_the_factoring_evaluator(tmp_path
     assert r.returncode == 2 and "face patch" in r.stderr, r.stderr
 
 
+def test_a_format_4_model_whose_log_is_held_dense_still_loads(tmp_path):
+    """A small log is kept as its sparse split factor (format 5); a model of format 4 held
+    it as dense blocks, and still loads and answers the same (1e-10: two factorizations
+    of one SPD matrix)."""
+    from flexcontact.dense_factor import DenseFactor
+    path = tmp_path / "dam"
+    manifest = model_file.prepare(BASE, DT, LEVELS, path, lags=0, progress=lambda *a: None,
+                                  logs=[BASE])
+    (entry,) = manifest["logs"]
+    assert entry["kind"] == model_file.SPLIT
+    now = what_if_json(path, ASKED)
+    # The same model as format 4 wrote it: the log's dense blocks in arrays.npz, no kind.
+    p = entry["prefix"] + "f_"
+    own = ScenarioEvaluator(BASE, DT, LEVELS, MPI.COMM_SELF).logs.get(BASE)
+    with np.load(path / "arrays.npz") as z:
+        arrays = {k: z[k] for k in z.files if not k.startswith(p)}
+    arrays.update(DenseFactor(own.W_hat, own.front_dofs).arrays(p))
+    np.savez(path / "arrays.npz", **arrays)
+    old = json.loads((path / "manifest.json").read_text())
+    old["format"] = 4
+    del old["logs"][0]["kind"]
+    old["files"]["arrays.npz"] = model_file._file_entry(path / "arrays.npz")
+    (path / "manifest.json").write_text(json.dumps(old))
+    got = what_if_json(path, ASKED)
+    assert got["counts"]["factorizations"]["log"] == 0
+    assert got["counts"]["restorations"]["log"] == now["counts"]["restorations"]["log"] == 1
+    for key in OUTPUTS:
+        assert got["outputs"][key] == pytest.approx(now["outputs"][key], rel=1e-10), key
+
+
 BASE_FINE_LOG = DamScenario(mesh_size_far_m=6.0, mesh_size_impact_m=0.4,
                             mesh_size_contact_m=0.0125, contact_zone_m=0.35,
                             log_end_crushes=True)

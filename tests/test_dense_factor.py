@@ -41,8 +41,8 @@ def test_small_body_factors_solve_as_the_mumps_schur_factor(log, Factor):
     assert np.abs(r.array_r - b.array_r).max() <= 1e-10 * np.abs(b.array_r).max()
 
 
-def test_the_log_holds_a_small_body_dense(log):
-    assert log.factor_kind == "dense" and log.factorizations == 1
+def test_the_log_holds_a_small_body_as_a_split_factor(log):
+    assert log.factor_kind == "split" and log.factorizations == 1
 
 
 def test_expand_needs_a_condense(log):

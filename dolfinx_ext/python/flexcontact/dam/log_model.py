@@ -35,12 +35,18 @@ import dolfinx.fem
 
 from .. import _cpp, compat, saved_factor
 from ..dense_factor import DenseFactor
+from ..split_factor import SplitFactor
 from .. import impact_setup as setup
 from ..forms import Material, elasticity_form, mass_form
 from ..meshes import dam as dam_mesh
 from ..meshes import dam_tags as T
 from ..pairing import _candidate_surface
 from ..errors import InputError
+
+
+SMALL_LOG_DOFS = 1500
+"""Largest log (DOFs) held as a sparse split factor; a larger one is factored by MUMPS,
+twice (its Schur complement on the front, and plain for its flight)."""
 
 
 def rotation(pitch_deg: float, yaw_deg: float = 0.0, dim: int = 2) -> np.ndarray:
@@ -191,9 +197,11 @@ class LogModel:
     diameter, E and ν to reuse (made here when None); ``end``: the front end's
     :class:`~flexcontact.meshes.log_end.LogEnd` (None: flat); ``dim``: 2 or 3 (that of
     ``mesh`` when given). ``mass_kg_per_m``: the log's mass with its added mass (kg/m in
-    2D, kg in 3D). ``factor_kind``: "dense" (a log of at most dense_factor.DENSE_LIMIT
-    DOFs, held as dense blocks) or "mumps_schur". ``factor``: a factor restored from a
-    model file instead of factoring (a DenseFactor, or MUMPS's Schur factor with its
+    2D, kg in 3D). ``factor_kind``: "split" (a log of at most :data:`SMALL_LOG_DOFS` DOFs,
+    held as a sparse split factor, split_factor.SplitFactor), "dense" (such a log restored
+    from a model file of format 4 or older, held as dense blocks) or "mumps_schur".
+    ``factor``: a factor restored from a model file instead of factoring (a SplitFactor or
+    DenseFactor, or MUMPS's Schur factor with its
     flexibility ``W_front`` on the front DOFs); ``flight_factor``: the plain factor of Ŵ
     restored with it (:meth:`solve_free`; None: a model file that has none, and the flight
     then takes the Schur factor's full solves). Serial.
@@ -223,14 +231,14 @@ class LogModel:
         self.front, self.front_dofs = self.mesh.front, self.mesh.front_dofs
         n = self.W_hat.getSize()[0]
         self.flight_factor = None
-        if isinstance(factor, DenseFactor):
+        if isinstance(factor, (SplitFactor, DenseFactor)):
             # Restored from a model file (dam/model_file.py): nothing factored.
             if factor.n != n or not np.array_equal(factor.c, self.front_dofs):
                 raise InputError(f"a saved log factor of {factor.n} DOFs does not fit this "
                                  f"log of {n} DOFs")
             self.factor, self.W_front = factor, factor.W
             self.restorations += 1
-            self.factor_kind = "dense"
+            self.factor_kind = "split" if isinstance(factor, SplitFactor) else "dense"
         elif factor is not None:
             # MUMPS's Schur factor restored from a model file with its F* (W_front).
             c = self.front_dofs.size
@@ -248,12 +256,13 @@ class LogModel:
                                      f"DOFs does not fit this log of {n} DOFs")
                 self.flight_factor = flight_factor
                 self.restorations += 1
-        elif DenseFactor.worth_it(n):
-            # A log of a few hundred DOFs: dense blocks beat the sparse solve's overhead.
-            self.factor = DenseFactor(self.W_hat, self.front_dofs)
+        elif n <= SMALL_LOG_DOFS:
+            # A sparse split factor: neither MUMPS's fixed cost per solve nor dense blocks'
+            # n² products and n³ set-up.
+            self.factor = SplitFactor(self.W_hat, self.front_dofs)
             self.W_front = self.factor.W
             self.factorizations += 1
-            self.factor_kind = "dense"
+            self.factor_kind = "split"
         else:
             F, self.factor, info = _cpp.flexibility(self.W_hat, self.front_dofs, "schur")
             self.W_front = np.asarray(F)

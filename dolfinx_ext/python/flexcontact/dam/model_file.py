@@ -8,8 +8,8 @@ The model is one directory, written atomically (complete or absent):
   dam's mesh, and the size and SHA-256 of every other file;
 * ``arrays.npz``: the face's condensed flexibility W_face, the base section's response
   functions (dam/response.py), the face compliance of the re-contact bound, the static
-  displacement of each water level it was asked for, and the config's logs held dense
-  (dense_factor.DENSE_LIMIT);
+  displacement of each water level it was asked for, and the config's small logs
+  (split_factor.SPLIT_LIMIT DOFs) as their sparse split factors;
 * a larger log of the config: ``logN_arrays.npz`` (its K, M₁, front and W_front), and
   MUMPS's files of its Schur factor on the front and of its plain factor (the flight after
   the contact, dam/log_model.py), read when a scenario first asks for it;
@@ -42,11 +42,13 @@ from .. import saved_factor
 from ..split_factor import SplitFactor
 from ..errors import SavedFileError
 
-MODEL_FORMAT = 4
+MODEL_FORMAT = 5
 """The model directory's format (2: a factor may be held in arrays.npz, "kind": "split";
-3: a large log kept as its own arrays file and MUMPS factor; 4: and its plain factor)."""
+3: a large log kept as its own arrays file and MUMPS factor; 4: and its plain factor; 5: a
+small log held as a sparse split factor, its entry's "kind" "split", where formats 2–4 held
+it as dense blocks)."""
 
-READABLE_FORMATS = (2, 3, 4)
+READABLE_FORMATS = (2, 3, 4, 5)
 """Formats this flexcontact loads (a format-2 model holds no large log; a format-3
 model's large log flies after the contact on its Schur factor, the same answer to
 round-off at three times the cost of a step); any other is refused."""
@@ -80,9 +82,8 @@ def prepare(base, dt_s: float, water_levels_m, path, levels=None,
     now (default: twice the steps of the base scenario's run; a longer run extends them on
     load, from the saved adjoint state, counted); ``strip_m``, ``patch_y_m``: the face
     region condensed (default: DamModel's); ``logs``: scenarios whose log models are kept
-    too (one per distinct log: dense in ``arrays.npz``, or a large log as its own arrays
-    file and MUMPS's Schur factor files). Returns the
-    manifest."""
+    too (one per distinct log: a small one's split factor in ``arrays.npz``, or a large log
+    as its own arrays file and MUMPS's Schur factor files). Returns the manifest."""
     from .dam_model import DamModel
     path = Path(path)
     t0 = time.perf_counter()
@@ -265,8 +266,8 @@ def load(path, comm=MPI.COMM_SELF, **evaluator_options):
             ev.logs.restore_later(s, None if ball is None else tuple(ball),
                                   lambda entry=entry, want=want: _large_log(path, entry, want))
         else:
-            ev.logs.restore(s, LogMesh.from_arrays(arrays, p),
-                            DenseFactor.from_arrays(arrays, p + "f_"))
+            small = SplitFactor if entry.get("kind") == SPLIT else DenseFactor
+            ev.logs.restore(s, LogMesh.from_arrays(arrays, p), small.from_arrays(arrays, p + "f_"))
     return ev
 
 
@@ -309,10 +310,10 @@ def logs_of(base, scenarios) -> list:
 
 def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> tuple[list, int]:
     """Build the log model of each distinct log among ``logs`` at the dam's time step and
-    return the manifest's entries and the factorizations this cost. A log held dense goes
-    into ``arrays``; a log factored by MUMPS (its Schur factor on the front) gets its own
-    arrays file in ``folder`` (its K, M₁, front and W_front) and MUMPS's factor files, read
-    only when a scenario asks for it."""
+    return the manifest's entries and the factorizations this cost. A small log (its split
+    factor) goes into ``arrays``; a log factored by MUMPS (its Schur factor on the front)
+    gets its own arrays file in ``folder`` (its K, M₁, front and W_front) and MUMPS's
+    factor files, read only when a scenario asks for it."""
     from .reuse import LogCache, log_key
     cache = LogCache(dam.dt, dam.comm, dam.theta)
     entries = []
@@ -322,9 +323,10 @@ def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> tuple[list, int]
         log = cache.get(s)
         p = f"log{len(entries)}_"
         entry = {"prefix": p, "scenario": s.as_dict()}
-        if log.factor_kind == "dense":
+        if log.factor_kind in (SPLIT, "dense"):
             arrays.update(log.mesh.arrays(p))
             arrays.update(log.factor.arrays(p + "f_"))
+            entry["kind"] = log.factor_kind
         else:
             entry["arrays"] = p + "arrays.npz"
             np.savez(folder / entry["arrays"], **log.mesh.arrays(p),
