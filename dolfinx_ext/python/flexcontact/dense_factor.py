@@ -13,8 +13,9 @@ and the three solves of the stepper (stepper.BodiesStepper) are dense products:
 * expand(u_c, x): x_c = u_c, x_i = z_i − T u_c;
 * solve(b, x): condense, u_c = W b̃_c, expand.
 
-``DenseFactor.worth_it(n)`` is the choice: dense below ``DENSE_LIMIT`` DOFs, where n² words
-still fit in a few MB and a dense product beats the sparse solve's overhead.
+A dam model's small logs were held this way up to model format 4, and such a model still
+loads them (dam/model_file.py); a log built now takes the sparse split factor
+(split_factor.SplitFactor), whose set-up and solves cost less (docs/architecture.md §7).
 """
 from __future__ import annotations
 
@@ -22,9 +23,6 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 from petsc4py import PETSc
-
-DENSE_LIMIT = 1500
-"""Largest body (DOFs) held dense: A_ii⁻¹ is then at most 18 MB."""
 
 
 def _spd_inverse(A: np.ndarray, what: str) -> np.ndarray:
@@ -80,10 +78,6 @@ class DenseFactor:
                                          for k in ("A_ii_inv", "T", "W"))
         self._z = None
         return self
-
-    @staticmethod
-    def worth_it(n: int) -> bool:
-        return n <= DENSE_LIMIT
 
     @property
     def n_contact_dofs(self) -> int:

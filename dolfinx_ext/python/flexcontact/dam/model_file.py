@@ -9,7 +9,7 @@ The model is one directory, written atomically (complete or absent):
 * ``arrays.npz``: the face's condensed flexibility W_face, the base section's response
   functions (dam/response.py), the face compliance of the re-contact bound, the static
   displacement of each water level it was asked for, and the config's small logs
-  (split_factor.SPLIT_LIMIT DOFs) as their sparse split factors;
+  (log_model.SMALL_LOG_DOFS) as their sparse split factors;
 * a larger log of the config: ``logN_arrays.npz`` (its K, M₁, front and W_front), and
   MUMPS's files of its Schur factor on the front and of its plain factor (the flight after
   the contact, dam/log_model.py), read when a scenario first asks for it;
