@@ -39,6 +39,23 @@ def test_a_linear_stress_is_recovered_exactly_on_a_centrally_symmetric_mesh(dim)
     assert value == pytest.approx(ref, rel=1e-10)
 
 
+def test_the_closed_form_largest_principal_stress_is_lapacks():
+    # Random symmetric tensors, and the cases where the trigonometric form is weakest: an
+    # isotropic one, a double largest eigenvalue, two largest apart by 1e-9 relative.
+    from flexcontact.dam.stress_probe import largest_principal
+    rng = np.random.default_rng(7)
+    t = 1e6 * rng.standard_normal((500, 3, 3))
+    t = t + t.transpose(0, 2, 1)
+    q, _ = np.linalg.qr(rng.standard_normal((3, 3)))
+    t[0] = 2e6 * np.eye(3)
+    t[1] = q @ np.diag([3e6, 3e6, -1e6]) @ q.T
+    t[2] = q @ np.diag([5e6, 5e6 * (1 - 1e-9), 1e6]) @ q.T
+    t[3] = q @ np.diag([-1e6, 4e6, 4e6 * (1 + 1e-7)]) @ q.T
+    ref = np.linalg.eigvalsh(t)[:, -1]
+    scale = np.abs(t).reshape(len(t), -1).max(axis=1)
+    assert np.all(np.abs(largest_principal(t) - ref) <= 1e-13 * scale)
+
+
 @pytest.mark.parametrize("diagonal", ["right", "crossed"])
 def test_the_flamant_tension_behind_a_line_load_converges(diagonal):
     # Exact: 2Q/(π r) at r = 0.5 m. Measured (right, crossed diagonals): 1.2 % and 1.4 %

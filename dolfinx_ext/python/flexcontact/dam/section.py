@@ -197,7 +197,8 @@ class OffsetProbe:
         if len(vals):
             i = int(np.argmax(vals))
             best, where = float(vals[i]), self.points[self.found[i]]
-        everyone = self.comm.allgather((best, where))
+        everyone = ([(best, where)] if self.comm.size == 1
+                    else self.comm.allgather((best, where)))
         best, where = max(everyone, key=lambda bw: bw[0])
         return (best, where) if np.isfinite(best) else (float("nan"), None)
 

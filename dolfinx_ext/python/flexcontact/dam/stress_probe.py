@@ -177,7 +177,7 @@ class RecoveredStressProbe:
             return self.offset.best(np.maximum(0.5 * (xx + yy) + np.hypot(0.5 * (xx - yy), xy),
                                                zz))
         t = self._tensors()
-        return self.offset.best(np.linalg.eigvalsh(t)[:, -1] if len(t) else np.zeros(0))
+        return self.offset.best(largest_principal(t) if len(t) else np.zeros(0))
 
     def mean(self) -> np.ndarray:
         """The recovered stress tensor (3, 3) in Pa averaged over the samples (nan if none
@@ -217,6 +217,28 @@ class RecoveredStressProbe:
             return np.zeros((0, self._ncomp))
         c = self._rec.eval(self.offset.points[found], self.offset.sample_cells)
         return np.asarray(c).reshape(len(found), self._ncomp)
+
+
+def largest_principal(t: np.ndarray) -> np.ndarray:
+    """The largest eigenvalue of each symmetric 3×3 matrix of ``t`` (k, 3, 3), in closed
+    form (the trigonometric solution of the characteristic cubic): a tenth of the time of
+    LAPACK's eigenvalues, which a 3D probe took at 2,880 samples per reading. Where the two
+    largest nearly coincide, the arccos loses half the digits, so those few take LAPACK's."""
+    a00, a11, a22 = t[:, 0, 0], t[:, 1, 1], t[:, 2, 2]
+    a01, a02, a12 = t[:, 0, 1], t[:, 0, 2], t[:, 1, 2]
+    q = (a00 + a11 + a22) / 3.0
+    b00, b11, b22 = a00 - q, a11 - q, a22 - q
+    p = np.sqrt((b00 * b00 + b11 * b11 + b22 * b22
+                 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12)) / 6.0)
+    det = (b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02)
+           + a02 * (a01 * a12 - b11 * a02))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.clip(np.where(p > 0, det / (2.0 * p ** 3), 0.0), -1.0, 1.0)
+    lam = q + 2.0 * p * np.cos(np.arccos(r) / 3.0)
+    near = r < -1.0 + 1e-6
+    if near.any():
+        lam[near] = np.linalg.eigvalsh(t[near])[:, -1]
+    return lam
 
 
 def _assembled(form, vec) -> np.ndarray:
