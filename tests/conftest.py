@@ -8,6 +8,11 @@ from pathlib import Path
 
 import pytest
 
+# gmsh installs a signal handler when imported, which Python allows only in the main thread.
+# Imported here first, because pytest-xdist's controller imports the module of a warning
+# raised in a worker (flexcontact.dam's, whose import reaches gmsh) from another thread.
+import gmsh  # noqa: F401
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "dolfinx_ext" / "python"))
 import flexcontact_checkout  # noqa: E402,F401  (forms/ and meshes/ as flexcontact's subpackages)
@@ -60,3 +65,15 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "slow: takes minutes (builds or installs the package)")
     if shutil.which("mpirun") is None:
         raise RuntimeError("mpirun not found: install openmpi-bin (scripts/setup.sh does)")
+
+
+# The files that take minutes (a module fixture at the main job's mesh, the wheel's build,
+# the 3D sweeps), run first: with one pytest worker per core (scripts/test.sh), a long file
+# started last would leave the other cores idle at the end.
+LONG_FILES = ("test_dam_reuse_3d.py", "test_install.py", "test_sweep.py", "test_demos_3d.py",
+              "test_node_surface.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    rank = {name: k for k, name in enumerate(LONG_FILES)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(LONG_FILES)))
