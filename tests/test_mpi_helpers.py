@@ -21,3 +21,32 @@ def test_a_message_becomes_the_given_exception_type():
 def test_an_exception_is_raised_as_it_is():
     with pytest.raises(KeyError):
         raise_on_every_rank(MPI.COMM_WORLD, KeyError("gmsh group"))
+
+
+def _refuse():
+    raise TypeError("this exception cannot be unpickled")
+
+
+def test_an_exception_is_not_pickled_in_serial(monkeypatch):
+    # A library may re-register how exceptions pickle (tblib, which dask's distributed
+    # installs, breaks MemoryError subclasses on Python 3.14): in serial the error is
+    # raised as it is, never sent through pickle.
+    import copyreg
+    from flexcontact.memory import ContactMemoryError
+    monkeypatch.setitem(copyreg.dispatch_table, ContactMemoryError,
+                        lambda error: (_refuse, ()))
+    found = ContactMemoryError("F* needs 466560 bytes", needed_bytes=466560.0)
+    with pytest.raises(ContactMemoryError) as caught:
+        raise_on_every_rank(MPI.COMM_WORLD, found)
+    assert caught.value is found
+
+
+@pytest.mark.mpi
+def test_an_exception_reaches_the_other_rank_with_its_numbers(tmp_path):
+    import json
+    from pathlib import Path
+    from conftest import on_two_ranks
+    on_two_ranks(Path(__file__).with_name("rank_error_case.py"), tmp_path / "rank1.json")
+    seen = json.loads((tmp_path / "rank1.json").read_text())
+    assert seen == {"message": "F* needs 466560 bytes", "needed_bytes": 466560.0,
+                    "available_bytes": 1e4, "n_contact_dofs": 108, "pairs": 27}

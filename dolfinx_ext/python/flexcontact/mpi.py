@@ -20,12 +20,33 @@ def raise_on_every_rank(comm, error: Optional[Union[str, BaseException]],
             Other ranks' values are ignored.
         kind: the exception type raised for a message (default InputError, a ValueError).
     """
-    error = comm.bcast(error, root=0)
+    if comm.size > 1:
+        error = _bcast_error(comm, error)
     if error is None or error == "":
         return
     if isinstance(error, BaseException):
         raise error
     raise (kind or InputError)(error)
+
+
+def _bcast_error(comm, error):
+    """Rank 0's finding on every rank. An exception crosses as its class, arguments and
+    attributes, and is rebuilt from them as pickle's default does. It is not pickled whole:
+    a library that changes how every exception pickles (tblib, which dask's distributed
+    installs) would otherwise turn some of ours (a MemoryError subclass on Python 3.14)
+    into an unpickling TypeError on the other ranks, hiding the message."""
+    packed = error
+    if comm.rank == 0 and isinstance(error, BaseException):
+        packed = (type(error), error.args, dict(vars(error)))
+    packed = comm.bcast(packed, root=0)
+    if comm.rank == 0:
+        return error
+    if isinstance(packed, tuple):
+        cls, args, state = packed
+        rebuilt = cls(*args)
+        rebuilt.__dict__.update(state)
+        return rebuilt
+    return packed
 
 
 def wait_for_root(comm, poll_s: float = 2e-4) -> None:
