@@ -80,6 +80,9 @@ def test_wheel_installs_complete_and_runs_outside_the_checkout(tmp_path):
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     # No index: any dependency pip would try to fetch makes the build fail here.
     env.update(PIP_NO_INDEX="1", PIP_DISABLE_PIP_VERSION_CHECK="1")
+    # The build from scratch is the suite's longest test: let it use every core (setup.py
+    # builds serially otherwise), as the other pytest workers finish.
+    env.setdefault("CMAKE_BUILD_PARALLEL_LEVEL", str(os.cpu_count() or 1))
     dist = tmp_path / "dist"
     build = subprocess.run([PYTHON, "-m", "pip", "wheel", "--no-build-isolation", "--no-deps",
                             "-w", str(dist), str(ROOT)], env=env, capture_output=True,
