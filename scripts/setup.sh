@@ -12,8 +12,8 @@ packages=(
   cmake g++ make pkg-config python3-dev libblas-dev liblapack-dev python3-venv python3-setuptools
   python3-dolfinx libdolfinx-dev petsc-dev python3-petsc4py python3-mpi4py openmpi-bin
   gmsh python3-gmsh libeigen3-dev pybind11-dev
-  googletest libgtest-dev python3-pytest python3-pytest-xdist python3-scipy python3-matplotlib python3-tqdm
-  python3-distributed libmetis-dev libmumps-dev
+  googletest libgtest-dev python3-pytest python3-pytest-xdist python3-scipy python3-matplotlib
+  python3-tqdm python3-distributed libmetis-dev libmumps-dev
   libopenblas0-serial
 )
 # Peer codes used as oracles by some tests; a distribution without them (Debian 13 has no
