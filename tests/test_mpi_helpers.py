@@ -1,9 +1,16 @@
 """flexcontact.mpi: rank 0's finding raised on every rank (serial here; the bad-input and
 pairing tests exercise it under mpirun)."""
+import copyreg
+import json
+from pathlib import Path
+
 import pytest
 from mpi4py import MPI
 
+from flexcontact.memory import ContactMemoryError
 from flexcontact.mpi import raise_on_every_rank
+
+from conftest import on_two_ranks
 
 
 def test_nothing_found_raises_nothing():
@@ -31,8 +38,6 @@ def test_an_exception_is_not_pickled_in_serial(monkeypatch):
     # A library may re-register how exceptions pickle (tblib, which dask's distributed
     # installs, breaks MemoryError subclasses on Python 3.14): in serial the error is
     # raised as it is, never sent through pickle.
-    import copyreg
-    from flexcontact.memory import ContactMemoryError
     monkeypatch.setitem(copyreg.dispatch_table, ContactMemoryError,
                         lambda error: (_refuse, ()))
     found = ContactMemoryError("F* needs 466560 bytes", needed_bytes=466560.0)
@@ -43,9 +48,6 @@ def test_an_exception_is_not_pickled_in_serial(monkeypatch):
 
 @pytest.mark.mpi
 def test_an_exception_reaches_the_other_rank_with_its_numbers(tmp_path):
-    import json
-    from pathlib import Path
-    from conftest import on_two_ranks
     on_two_ranks(Path(__file__).with_name("rank_error_case.py"), tmp_path / "rank1.json")
     seen = json.loads((tmp_path / "rank1.json").read_text())
     assert seen == {"message": "F* needs 466560 bytes", "needed_bytes": 466560.0,

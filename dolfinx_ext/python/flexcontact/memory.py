@@ -30,7 +30,8 @@ class ContactMemoryError(FlexcontactError, MemoryError):
     of the message; the message names the option to use instead (``contact_operator="factor"``).
     """
 
-    # Defaults: an exception is pickled with its message only (rank 0 broadcasts it).
+    # Defaults: on the other ranks it is rebuilt from its message, then its attributes set
+    # (flexcontact.mpi.raise_on_every_rank).
     def __init__(self, text: str, needed_bytes: float = 0.0, available_bytes: float = 0.0,
                  n_contact_dofs: int = 0, pairs: int = 0):
         super().__init__(text)
