@@ -70,6 +70,11 @@ def _box_record(dim, n):
     factor.distributed_io = False
     out.update({f"{k}_central": v for k, v in _condense_expand(factor, K, b_all, uc_all).items()})
     out["io_refusal"] = int(factor.io_refusal)
+    try:  # several right-hand sides at once are served on one rank only
+        factor.condense_many(np.zeros((N, 2)))
+        out["many_refused"] = ""
+    except RuntimeError as e:
+        out["many_refused"] = str(e)
     factor.destroy()
     return out
 
@@ -171,6 +176,14 @@ def _serial(K_dense, bs):
                               comm=PETSc.COMM_SELF)
     K.assemble()
     return K
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("dim", [d for d, _ in BOXES])
+def test_two_ranks_refuse_several_right_hand_sides_at_once_by_name(two_ranks, dim):
+    assert str(two_ranks[0][f"many_refused_{dim}"]) == (
+        "condense_many: the factor is distributed over 2 processes; several right-hand "
+        "sides at once are served on one")
 
 
 @pytest.mark.mpi

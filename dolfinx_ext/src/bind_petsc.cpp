@@ -65,6 +65,16 @@ void bind_saved_factor(py::module& m)
            "Write the factor as MUMPS's files <dir>/<prefix>_* (JOB=7)")
       .def("solve", &solve_without_gil<SavedFactor>, py::arg("b"), py::arg("x"),
            "x = A^-1 b: one back-substitution")
+      .def(
+          "solve_many",
+          [](SavedFactor& f, const Eigen::Ref<const Eigen::MatrixXd>& B)
+          {
+            py::gil_scoped_release release;
+            return f.solve_many(B);
+          },
+          py::arg("B"),
+          "X = A^-1 B for the k columns of B (n x k) in one MUMPS call that reads the "
+          "factor once")
       .def_property_readonly("size", &SavedFactor::size)
       .def_property_readonly("factor_entries", &SavedFactor::factor_entries)
       .def("destroy", &SavedFactor::release, "Release the factor");
@@ -131,6 +141,26 @@ void bind_distributed_schur(py::module& m)
           py::arg("u_c"), py::arg("x"),
           "x = the solution whose contact values are u_c (rank 0), for the right-hand side "
           "of the last condense().")
+      .def(
+          "condense_many",
+          [](DistributedSchur& f, const Eigen::Ref<const Eigen::MatrixXd>& B)
+          {
+            py::gil_scoped_release release;
+            return f.condense_many(B);
+          },
+          py::arg("B"),
+          "One rank: the reduced right-hand sides of the k columns of B (n x k, an F-ordered "
+          "array avoids a copy) in one MUMPS call that reads the factor once: n_c x k.")
+      .def(
+          "expand_many",
+          [](DistributedSchur& f, const Eigen::Ref<const Eigen::MatrixXd>& U_c)
+          {
+            py::gil_scoped_release release;
+            return f.expand_many(U_c);
+          },
+          py::arg("U_c"),
+          "One rank: the solutions (n x k) whose contact values are the columns of U_c "
+          "(n_c x k), for the right-hand sides of the last condense_many().")
       .def_property(
           "distributed_io", &DistributedSchur::distributed_io,
           &DistributedSchur::set_distributed_io,

@@ -221,6 +221,7 @@ void DistributedSchur::release()
 {
   end_instance(id_, alive_);
   condensed_ = false;
+  batch_k_ = 0;
   int finalized = 0;
   MPI_Finalized(&finalized);
   if (!finalized and comm_ != MPI_COMM_NULL)
@@ -235,6 +236,8 @@ void DistributedSchur::release()
   std::vector<double>().swap(schur_);
   std::vector<double>().swap(rhs_);
   std::vector<double>().swap(condensed_rhs_);
+  std::vector<double>().swap(batch_rhs_);
+  std::vector<double>().swap(batch_redrhs_);
   std::vector<double>().swap(rhs_loc_);
   std::vector<double>().swap(sol_buf_);
   std::vector<double>().swap(host_rhs_stub_);
@@ -345,6 +348,7 @@ std::vector<double> DistributedSchur::condense(Vec b)
   else
     condense_centralised(b);
   condensed_ = true;
+  batch_k_ = 0;
   return rank_ == 0 ? redrhs_ : std::vector<double>();
 }
 
@@ -424,11 +428,99 @@ void DistributedSchur::condense_distributed(Vec b)
   condensed_distributed_ = true;
 }
 
+Eigen::MatrixXd DistributedSchur::condense_many(const Eigen::Ref<const Eigen::MatrixXd>& B)
+{
+  if (!alive_)
+    throw std::runtime_error("the MUMPS factor was destroyed");
+  if (size_ != 1)
+    throw std::logic_error("condense_many: the factor is distributed over "
+                           + std::to_string(size_) + " processes; several right-hand sides "
+                           "at once are served on one");
+  if (B.rows() != n_ or B.cols() < 1)
+    throw std::invalid_argument("condense_many: B has " + std::to_string(B.rows()) + " rows and "
+                                + std::to_string(B.cols()) + " columns; K has "
+                                + std::to_string(n_) + " rows, and at least one is needed");
+  times_ = {};
+  const int k = static_cast<int>(B.cols());
+  batch_rhs_.assign(B.data(), B.data() + B.size());
+  batch_redrhs_.assign(static_cast<std::size_t>(n_c_) * k, 0.0);
+  id_.rhs = batch_rhs_.data();
+  id_.lrhs = static_cast<int>(n_);
+  id_.redrhs = batch_redrhs_.data();
+  id_.lredrhs = std::max(n_c_, 1);
+  icntl(id_, 20) = 0;
+  icntl(id_, 21) = 0;
+  id_.nrhs = k;
+  icntl(id_, 26) = n_c_ > 0 ? 1 : 0;
+  const double t0 = MPI_Wtime();
+  try
+  {
+    call(3, "condensation of several right-hand sides");
+  }
+  catch (...)
+  {
+    id_.nrhs = 1;
+    batch_k_ = 0;
+    condensed_ = false;
+    throw;
+  }
+  times_.condense_s = MPI_Wtime() - t0;
+  id_.nrhs = 1;
+  condensed_ = true;
+  condensed_distributed_ = false;
+  batch_k_ = k;
+  return Eigen::Map<const Eigen::MatrixXd>(batch_redrhs_.data(), n_c_, k);
+}
+
+Eigen::MatrixXd DistributedSchur::expand_many(const Eigen::Ref<const Eigen::MatrixXd>& U_c)
+{
+  if (!condensed_ or batch_k_ == 0)
+    throw std::runtime_error("expand_many: no condense_many since the last expansion or "
+                             "solve (one expansion per condensation)");
+  if (U_c.rows() != n_c_ or U_c.cols() != batch_k_)
+    throw std::invalid_argument("expand_many: U_c is " + std::to_string(U_c.rows()) + " × "
+                                + std::to_string(U_c.cols()) + "; the last condense_many "
+                                "needs " + std::to_string(n_c_) + " × "
+                                + std::to_string(batch_k_));
+  const int k = batch_k_;
+  condensed_ = false;
+  batch_k_ = 0;
+  std::copy(U_c.data(), U_c.data() + U_c.size(), batch_redrhs_.begin());
+  id_.rhs = batch_rhs_.data();
+  id_.lrhs = static_cast<int>(n_);
+  id_.redrhs = batch_redrhs_.data();
+  id_.lredrhs = std::max(n_c_, 1);
+  id_.nrhs = k;
+  icntl(id_, 26) = n_c_ > 0 ? 2 : 0;
+  const double t0 = MPI_Wtime();
+  try
+  {
+    if (n_c_ > 0) // else the condensation was the whole solve
+      call(3, "expansion of several right-hand sides");
+  }
+  catch (...)
+  {
+    id_.nrhs = 1;
+    throw;
+  }
+  times_.expand_s = MPI_Wtime() - t0;
+  id_.nrhs = 1;
+  Eigen::MatrixXd X = Eigen::Map<const Eigen::MatrixXd>(batch_rhs_.data(), n_, k);
+  // The Schur rows are U_c itself: set them from it, as the single expansion's scatter does.
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < n_c_; ++i)
+      X(schur_rows_[i], j) = U_c(i, j);
+  return X;
+}
+
 void DistributedSchur::expand(std::span<const double> u_c, Vec x)
 {
   if (!condensed_)
     throw std::runtime_error("expand: no condense since the last expand or solve (one "
                              "expansion per condensation)");
+  if (batch_k_ > 0)
+    throw std::runtime_error("expand: the last condensation was condense_many; expand its "
+                             "right-hand sides with expand_many");
   // The centralised variant overwrites the kept forward elimination with the solution.
   condensed_ = false;
   if (condensed_distributed_)

@@ -117,6 +117,19 @@ public:
   /// the last condense(). Collective.
   void expand(std::span<const double> u_c, Vec x);
 
+  /// @brief One rank: the condensations of k right-hand sides (the columns of B, n × k) in
+  /// one call, so that MUMPS reads its factor once for all of them: b̃ (n_c × k). Scenarios
+  /// stepped side by side share a dam this way (docs/architecture.md §7, "Several
+  /// right-hand sides at once"). They stay here for expand_many().
+  /// @throws std::logic_error on several ranks, std::invalid_argument on B's row count
+  Eigen::MatrixXd condense_many(const Eigen::Ref<const Eigen::MatrixXd>& B);
+
+  /// @brief One rank: the solutions (n × k) whose contact rows are the columns of U_c, for
+  /// the right-hand sides of the last condense_many().
+  /// @throws std::runtime_error without that condensation, std::invalid_argument on U_c's
+  ///   size
+  Eigen::MatrixXd expand_many(const Eigen::Ref<const Eigen::MatrixXd>& U_c);
+
   /// @brief Distributed (true, the default on several ranks) or centralised (the default on
   /// one) right-hand side and solution;
   /// the same value on every rank. Takes effect at the next condense().
@@ -153,6 +166,8 @@ private:
   bool schur_symmetric_ = false; ///< F* exactly symmetric: a product reads its lower half
   std::shared_ptr<const BlockFlexibility> factors_; ///< F* by block, when kept so
   bool condensed_ = false;
+  int batch_k_ = 0;              ///< right-hand sides of the last condense_many (0: none)
+  std::vector<double> batch_rhs_, batch_redrhs_; ///< their n × k and n_c × k arrays
   VecScatter to_zero_ = nullptr; ///< K's row layout → all on rank 0
   Vec host_ = nullptr;           ///< the N values on rank 0 (0 elsewhere)
   DistributedFactorStats stats_;

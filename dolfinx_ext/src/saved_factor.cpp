@@ -145,6 +145,32 @@ void SavedFactor::solve(Vec b, Vec x)
   err.check(VecRestoreArray(x, &px), "VecRestoreArray");
 }
 
+Eigen::MatrixXd SavedFactor::solve_many(const Eigen::Ref<const Eigen::MatrixXd>& B)
+{
+  if (!alive_)
+    throw std::runtime_error("SavedFactor: the factor was released");
+  if (B.rows() != n_ or B.cols() < 1)
+    throw std::invalid_argument("SavedFactor.solve_many: B has " + std::to_string(B.rows())
+                                + " rows and " + std::to_string(B.cols()) + " columns; the "
+                                "factor has " + std::to_string(n_) + " rows, and at least "
+                                "one column is needed");
+  Eigen::MatrixXd X = B;
+  id_.nrhs = static_cast<int>(X.cols());
+  id_.lrhs = static_cast<int>(n_);
+  id_.rhs = X.data();
+  try
+  {
+    call(3, "solve of several right-hand sides");
+  }
+  catch (...)
+  {
+    id_.nrhs = 1;
+    throw;
+  }
+  id_.nrhs = 1;
+  return X;
+}
+
 double SavedFactor::factor_entries() const
 {
   const int e = infog(id_, 29) != 0 ? infog(id_, 29) : infog(id_, 20);

@@ -11,6 +11,7 @@
 /// valid for the same MUMPS version: the Python side (saved_factor.py) records it and checks
 /// the files' sizes and hashes before MUMPS reads them.
 
+#include <Eigen/Dense>
 #include <dmumps_c.h>
 #include <petscmat.h>
 
@@ -39,6 +40,12 @@ public:
 
   /// @brief x = A⁻¹ b (serial Vecs of n entries); one back-substitution.
   void solve(Vec b, Vec x);
+
+  /// @brief X = A⁻¹ B for the k columns of B (n × k) in one MUMPS call, which reads the
+  /// factor once for all of them (docs/architecture.md §7, "Several right-hand sides at
+  /// once").
+  /// @throws std::invalid_argument on B's row count
+  Eigen::MatrixXd solve_many(const Eigen::Ref<const Eigen::MatrixXd>& B);
 
   PetscInt size() const { return n_; }
   /// @brief Entries of the factor (INFOG(29), or INFOG(20) once restored).
