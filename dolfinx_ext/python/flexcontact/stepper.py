@@ -37,6 +37,7 @@ from ._cpp import ConvergenceError
 from .floating import NoEquilibriumError
 from .mpi import raise_on_every_rank, wait_for_root
 from .errors import InputError
+from .shared_solves import Condense, Expand, Solve, serve_alone
 
 Failure = tuple  # (message, report dict or None, no-equilibrium flag)
 
@@ -281,21 +282,36 @@ class BodiesStepper:
         is ``step_condensed(*before, values, *after)`` on the split path, with ``values``
         the bodies' condensed right-hand sides, or ``step(*before, values, *after)`` with
         the contact values of A_b⁻¹ b_b plus ``free_shift`` otherwise."""
+        return serve_alone(self.advance_requests(rhs, where=where, before=before, after=after,
+                                                 free_shift=free_shift))
+
+    def advance_requests(self, rhs: Sequence[Optional[PETSc.Vec]], *, where: str,
+                         before: Sequence = (), after: Sequence = (),
+                         free_shift: Optional[np.ndarray] = None):
+        """:meth:`advance` as a generator that yields its solves (shared_solves) instead of
+        making them, and returns advance's value: driven by shared_solves.serve_together,
+        several runs sharing a body's factor share its calls."""
         split = self.split
-        values, free = [], []
+        ops, free = [], []
         for body, b in zip(self.bodies, rhs):
             if b is None:
-                values.append(np.zeros(body.dofs.size))
                 free.append(None)
             elif split:
-                values.append(self._to_kernel(body, body.factor.condense(b)))
+                ops.append(Condense(body.factor, b))
                 free.append(None)
             else:
                 y0 = body.new_vector()
-                body.factor.solve(b, y0)
+                ops.append(Solve(body.factor, b, y0))
                 self._count(body)
-                values.append(self._to_kernel(body, y0.array_r[body.dofs]))
                 free.append(y0)
+        answers = iter((yield ops) if ops else ())
+        values = []
+        for body, b, y0 in zip(self.bodies, rhs, free):
+            if b is None:
+                values.append(np.zeros(body.dofs.size))
+                continue
+            got = next(answers)
+            values.append(self._to_kernel(body, got if split else y0.array_r[body.dofs]))
         values = np.concatenate(values)
         if not split and free_shift is not None:
             values = values + free_shift
@@ -310,23 +326,34 @@ class BodiesStepper:
         self.crossings += 1
         key = self.expand_key if split else "reaction"
         change = np.asarray(out[key])
-        ys = []
+        first, second, spent, ys = [], [], [], []
         for body, b, part, y0 in zip(self.bodies, rhs, self._slices, free):
             local = self._from_kernel(body, change[part])
-            ys.append(self._body_solution(body, b, local, y0, split))
+            ys.append(self._body_solution(body, b, local, y0, split, first, second, spent))
+        if first:
+            yield first
+        if second:
+            yield second
+        for v in spent:
+            v.destroy()
         return out, ys
 
-    def _body_solution(self, body, b, local, y0, split) -> Optional[PETSc.Vec]:
+    def _body_solution(self, body, b, local, y0, split, first, second,
+                       spent) -> Optional[PETSc.Vec]:
+        """The body's y, its solves appended to ``first`` (and to ``second`` when they need
+        a condensation first), its temporary vectors to ``spent``."""
         pushed = bool(np.any(local != 0.0))
         if not pushed and b is None:
             return None                       # at rest and untouched: nothing to solve
         if split:
-            if b is None:
-                b = body.new_vector()         # an expansion follows its own condensation
-                body.factor.condense(b)
-                b.destroy()
             y = body.new_vector()
-            body.factor.expand(local, y)
+            if b is None:
+                zero = body.new_vector()      # an expansion follows its own condensation
+                first.append(Condense(body.factor, zero))
+                second.append(Expand(body.factor, local, y))
+                spent.append(zero)
+            else:
+                first.append(Expand(body.factor, local, y))
             self._count(body)
             return y
         if not pushed:
@@ -334,11 +361,11 @@ class BodiesStepper:
         r = body.new_vector() if b is None else b.copy()
         r.array[body.dofs] += local
         y = body.new_vector()
-        body.factor.solve(r, y)
+        first.append(Solve(body.factor, r, y))
         self._count(body)
-        r.destroy()
+        spent.append(r)
         if y0 is not None:
-            y0.destroy()
+            spent.append(y0)
         return y
 
 

@@ -29,6 +29,7 @@ from ..condensation import kernel_pairs
 from ..pairing import pair_caps
 from ..impact_output import contact_metrics, filter_steps, force_at_filtered_peak
 from ..postprocess import impact_step_forces, peak_pressure_Pa
+from ..shared_solves import Solve, serve_alone
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .key_numbers import halfspace_tension_Pa
@@ -100,8 +101,18 @@ to the end)."""
 def run_impact(dam, log, s, static, offset_m: float = 1.0,
                after_contact: str = "convolve", histories: bool = False,
                timings: Optional[dict] = None) -> dict:
+    """The impact of scenario ``s`` alone (:func:`impact_run`, its solves made one by one)."""
+    return serve_alone(impact_run(dam, log, s, static, offset_m, after_contact, histories,
+                                  timings))
+
+
+def impact_run(dam, log, s, static, offset_m: float = 1.0,
+               after_contact: str = "convolve", histories: bool = False,
+               timings: Optional[dict] = None):
     """The impact of scenario ``s`` (a DamScenario) from the static state ``static`` of
-    ``dam`` at its water level, with ``log`` (the LogModel of its log). Returns the outputs
+    ``dam`` at its water level, with ``log`` (the LogModel of its log), as a generator of
+    its solves (shared_solves: served alone by :func:`run_impact`, or beside other
+    scenarios' by ScenarioEvaluator.evaluate_many). Returns the outputs
     (plain floats, see ScenarioEvaluator.evaluate); with ``histories``, also
     "history": {section quantity: its change after each step} and "face_impulses".
 
@@ -113,7 +124,7 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
 
     ``timings``: a dict to which the seconds of the steps with the dam stepped
     ("coupled_steps_s"), of those with the log alone ("log_only_steps_s") and of the
-    convolution ("convolution_s") are added."""
+    convolution ("convolution_s") are added (wall time: beside other runs, theirs too)."""
     if after_contact not in AFTER_CONTACT:
         raise ValueError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
     h, theta, d = dam.dt, dam.theta, s.dim
@@ -143,7 +154,8 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
     records, peak_principal, p_peak = [], -math.inf, 0.0
     section = {q: np.zeros(n) for q in dam.section_gradients}
     impulses = np.zeros((n, dam.face_dofs.size))
-    solves0 = (dam.back_substitutions["dam_stage2"], log.back_substitutions)
+    alone = {"dam": 0, "log": 0}  # this run's solves outside the stepper (beside other runs,
+    # the models' own counters also count theirs)
     stepper = BodiesStepper(kernel, [
         CondensedBody("log", log.factor, log.front_dofs, log.new_vector, rotation=R,
                       counted=_log_solve_counter(log)),
@@ -160,18 +172,19 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
         if stopped is not None:
             if _cannot_touch(pairs.x[:m], u_log, _log_values(log, bl.omega, R, V0), face_x,
                              stopped["bound"], h, _crush_recess(kernel, pairs)):
-                bl.advance(_free_log_step(log, bl), h, theta)
+                bl.advance((yield from _free_log_step(log, bl, alone)), h, theta)
                 records.append(SimpleNamespace(t_s=(i + 1) * h, active=0, normal_force=0.0))
                 clock["log_only_steps_s"] += time.perf_counter() - t_step
                 continue
-            _replay(dam, bd, stopped["step"], i, h, theta, section)  # back to stepping
+            # back to stepping
+            yield from _replay(dam, bd, stopped["step"], i, h, theta, section, alone)
             stopped = None
         u_c = np.concatenate([u_log, u_face0 + bd.w.array_r[dam.face_dofs]])
         v_c = np.concatenate([_log_values(log, bl.omega, R, V0),
                               bd.omega.array_r[dam.face_dofs]])
         rhs = [bl.rhs(), bd.rhs()]
-        out, (dv_l, dv_d) = stepper.advance(rhs, where=f"time step {i + 1}", before=(u_c, v_c),
-                                            free_shift=v_c)
+        out, (dv_l, dv_d) = yield from stepper.advance_requests(
+            rhs, where=f"time step {i + 1}", before=(u_c, v_c), free_shift=v_c)
         for b in rhs:
             if b is not None:
                 b.destroy()
@@ -219,8 +232,8 @@ def run_impact(dam, log, s, static, offset_m: float = 1.0,
                                        filter_steps(force_filter_window_s(s), h))
         out["halfspace_tension_Pa"] = halfspace_tension_Pa(s, force, static_stress, offset_m)
     out.update(_section_outputs(static, section))
-    out["dam_back_substitutions"] = dam.back_substitutions["dam_stage2"] - solves0[0]
-    out["log_back_substitutions"] = log.back_substitutions - solves0[1]
+    out["dam_back_substitutions"] = stepper.back_substitutions["dam"] + alone["dam"]
+    out["log_back_substitutions"] = stepper.back_substitutions["log"] + alone["log"]
     out["dam_steps_convolved"] = int(n - stopped["step"]) if stopped is not None else 0
     if histories:
         out["history"] = section
@@ -261,25 +274,31 @@ def _cannot_touch(x_log, u_log, v_log, face_x, bound, h: float,
     return bool(front + reach < (face_x - bound).min())
 
 
-def _free_log_step(log, body):
-    """The log's velocity change in a step without contact (None while it flies rigidly)."""
+def _free_log_step(log, body, counts: dict):
+    """The log's velocity change in a step without contact (None while it flies rigidly);
+    a generator of its one solve, counted in ``counts["log"]`` and the log's counter."""
     b = body.rhs()
     if b is None:
         return None
     y = log.new_vector()
-    log.solve_free(b, y)
+    yield [Solve(log.free_factor(), b, y)]
+    log.back_substitutions += 1
+    counts["log"] += 1
     b.destroy()
     return y
 
 
-def _replay(dam, body, first: int, stop: int, h: float, theta: float, section: dict) -> None:
+def _replay(dam, body, first: int, stop: int, h: float, theta: float, section: dict,
+            counts: dict):
     """Step the dam alone (no impulse) through steps ``first``..``stop``−1, which were not
-    stepped, recording its section (a re-contact needs its state)."""
+    stepped, recording its section (a re-contact needs its state); a generator of its
+    solves, counted in ``counts["dam"]`` and the dam's counter."""
     for k in range(first, stop):
         b = body.rhs()
         y = dam.new_vector()
-        dam.factor.solve(b, y)
+        yield [Solve(dam.factor, b, y)]
         dam.back_substitutions["dam_stage2"] += 1
+        counts["dam"] += 1
         b.destroy()
         body.advance(y, h, theta)
         for q, v in dam.section_change(body.w).items():

@@ -203,7 +203,7 @@ class LogModel:
     ``factor``: a factor restored from a model file instead of factoring (a SplitFactor or
     DenseFactor, or MUMPS's Schur factor with its
     flexibility ``W_front`` on the front DOFs); ``flight_factor``: the plain factor of Ŵ
-    restored with it (:meth:`solve_free`; None: a model file that has none, and the flight
+    restored with it (:meth:`free_factor`; None: a model file that has none, and the flight
     then takes the Schur factor's full solves). Serial.
     """
 
@@ -317,11 +317,10 @@ class LogModel:
     def W_front_global(self, R: np.ndarray) -> np.ndarray:
         return rotate_blocks(self.W_front, R)
 
-    def solve_free(self, b: PETSc.Vec, y: PETSc.Vec) -> None:
-        """y = Ŵ⁻¹ b for a step without contact (one back-substitution, counted): by the
-        plain factor where the log has one, else by its contact factor."""
-        (self.factor if self.flight_factor is None else self.flight_factor).solve(b, y)
-        self.back_substitutions += 1
+    def free_factor(self):
+        """The factor of a step without contact: the plain one where the log has one, else
+        its contact factor."""
+        return self.factor if self.flight_factor is None else self.flight_factor
 
     def step_rhs(self, w: PETSc.Vec, omega: PETSc.Vec) -> PETSc.Vec:
         """h[−K (w + hθ ω)]: the right-hand side of a time step with no load, local frame

@@ -20,12 +20,13 @@ and a round log placed by its pitch, yaw and position across the block).
 from __future__ import annotations
 
 import time
-from typing import Optional
+from typing import Optional, Sequence
 
 from mpi4py import MPI
 
 from .. import impact_setup as setup
-from .coupled_step import AFTER_CONTACT, expected_contact_s, run_impact
+from ..shared_solves import Together, serve_alone, serve_together, shares
+from .coupled_step import AFTER_CONTACT, expected_contact_s, impact_run, run_impact
 from .dam_model import DamModel, front_end_span_m
 from .log_model import LogMesh, LogModel, contact_ball
 from .scenario import DamScenario
@@ -173,6 +174,7 @@ class ScenarioEvaluator:
         self.logs = LogCache(self.dt, self.dam.comm, self.dam.theta)
         self._steps_s = 0.0
         self._split: dict = {}  # run_impact's coupled steps, log-only steps, convolution
+        self.together = Together()  # evaluate_many's shared calls
         self.setup_s = time.perf_counter() - t0
 
     def check(self, scenario: DamScenario) -> None:
@@ -222,14 +224,59 @@ class ScenarioEvaluator:
         self._steps_s += out["evaluate_s"]
         return out
 
+    def evaluate_many(self, scenarios: Sequence[DamScenario]) -> list:
+        """The outputs of several scenarios stepped side by side (docs/architecture.md §7,
+        "Several right-hand sides at once"): each step's solves of the dam, and of the logs
+        they share, made in one call per factor (shared_solves.serve_together). Per
+        scenario, its outputs as :meth:`evaluate` gives them to round-off, or the error
+        it raised (a bad scenario fails alone; the others go on). ``evaluate_s`` is the
+        batch's wall time shared equally. A dam or log factor that holds one pending
+        condensation only (a split factor: the 2D section, a small log) cannot be shared:
+        the scenarios are then evaluated one after the other."""
+        scenarios = list(scenarios)
+        results: list = [None] * len(scenarios)
+        runs, where = [], []
+        for k, s in enumerate(scenarios):
+            try:
+                self.check(s)
+                log = self.log_model(s)
+                static = self.dam.static_state(s.water_level_m)
+            except Exception as err:  # noqa: BLE001: the scenario's failure is its result
+                results[k] = err
+                continue
+            runs.append(impact_run(self.dam, log, s, static, self.offset_m, self.after_contact))
+            where.append(k)
+        together = shares(self.dam.factor) and all(
+            shares(self.log_model(scenarios[k]).factor) for k in where)
+        t0 = time.perf_counter()
+        if together:
+            done = serve_together(runs, self.together)
+        else:
+            done = []
+            for run in runs:
+                try:
+                    done.append(serve_alone(run))
+                except Exception as err:  # noqa: BLE001
+                    done.append(err)
+        wall = time.perf_counter() - t0
+        self._steps_s += wall
+        for k, out in zip(where, done):
+            if isinstance(out, dict):
+                out["evaluate_s"] = wall / max(len(runs), 1)
+            results[k] = out
+        return results
+
     def timings(self) -> dict:
         """Cumulative seconds: the dam's set-up (meshing, assembly, its two factorizations and
         W_face), the logs' set-up (meshing, factorization, condensation) and the time steps
         with the outputs they monitor, split into the steps with the dam stepped (the
-        contact), those with the log alone, and the convolution after them."""
+        contact), those with the log alone, and the convolution after them; for the
+        scenarios evaluated side by side (:meth:`evaluate_many`), the shared calls'
+        seconds per kind and the runs' own ("shared_condense_s", …, "shared_runs_s")."""
+        shared = {f"shared_{k}_s": v for k, v in self.together.seconds.items() if v}
         return {"dam_setup_s": self.setup_s,
                 "log_setup_s": self.logs.setup_s(),
-                "steps_s": self._steps_s, **self._split}
+                "steps_s": self._steps_s, **self._split, **shared}
 
     def counts(self) -> dict:
         """{"factorizations": {"dam_stage1", "dam_stage2", "log"}, "back_substitutions":
