@@ -39,6 +39,7 @@ def main():
     ap.add_argument("--workers", type=int, default=None, help="overrides engine.workers")
     ap.add_argument("--engine", choices=("serial", "processes", "mpi", "dask"), default=None)
     ap.add_argument("--evaluator", default=None, help="overrides engine.evaluator")
+    ap.add_argument("--batch", type=int, default=None, help="overrides engine.batch")
     ap.add_argument("--n", type=int, default=None, help="overrides sample.n (a trial run)")
     ap.add_argument("--model", default=None,
                     help="engine.model: a dam model directory the workers load (prepared "
@@ -57,7 +58,8 @@ def main():
     if args.n is not None:
         raw["sample"]["n"] = args.n
     for key, value in (("workers", args.workers), ("kind", args.engine),
-                       ("evaluator", args.evaluator), ("model", args.model)):
+                       ("evaluator", args.evaluator), ("model", args.model),
+                       ("batch", args.batch)):
         if value is not None:
             raw.setdefault("engine", {})[key] = value
     if args.own_factors:
@@ -75,11 +77,13 @@ def main():
     # (meshing, assembly, factorizations); evaluate_s alone (no timings()) gives no split.
     phases = {k: v for k, v in ev.items() if k != "evaluate_s"}
     # The parts of the steps (coupled steps, log-only steps, convolution) are inside steps_s.
-    inside = ("steps_s", "outputs_s", "coupled_steps_s", "log_only_steps_s", "convolution_s")
+    inside = ("steps_s", "outputs_s", "coupled_steps_s", "log_only_steps_s", "convolution_s",
+              "shared_condense_s", "shared_expand_s", "shared_solve_s", "shared_runs_s")
     setup = (sum(v for k, v in phases.items() if k not in inside) if phases else None)
     result = {
         "config": args.config, "scenarios": s["scenarios"], "computed": s["computed_this_run"],
         "evaluator": s["evaluator"], "engine": s["engine"], "workers": s["workers"],
+        "batch": cfg.engine.get("batch", 1),
         "dt_s": s["dt_s"], "wall_s": wall, "phases_wall_s": s["timings_s"],
         "evaluator_split_process_s": {"setup_and_factorizations": setup,
                                       "steps": ev.get("steps_s"), "outputs": ev.get("outputs_s"),

@@ -88,3 +88,23 @@ class EndShapeEvaluator(LinearEvaluator):
         out = super().evaluate(s)
         out["peak_force_N_per_m"] *= END_FACTOR[s.log_end_shape]
         return out
+
+
+class BatchingEvaluator(LinearEvaluator):
+    """A LinearEvaluator with ``evaluate_many`` (as the reusing engine's): per scenario its
+    outputs or the error it raised. ``SWEEP_FAKE_FAIL_SPEED_ABOVE``: speeds above it fail."""
+
+    def evaluate(self, s) -> dict:
+        limit = os.environ.get("SWEEP_FAKE_FAIL_SPEED_ABOVE")
+        if limit is not None and s.log_speed_m_s > float(limit):
+            raise RuntimeError(f"log speed {s.log_speed_m_s!r} above {limit}")
+        return super().evaluate(s)
+
+    def evaluate_many(self, scenarios) -> list:
+        out = []
+        for s in scenarios:
+            try:
+                out.append(self.evaluate(s))
+            except RuntimeError as err:
+                out.append(err)
+        return out

@@ -125,6 +125,8 @@ BAD = [
     ({"base": {"water_level_m": 40.0}}, ["water_level_m=40.0", "overtopped"]),
     ({"engine": {"kind": "cluster"}}, ["engine.kind", "'cluster'"]),
     ({"engine": {"model": True}}, ["engine.model=True", "or false"]),
+    ({"engine": {"batch": 0}}, ["engine.batch=0", "integer >= 1"]),
+    ({"engine": {"batch": 2.5}}, ["engine.batch=2.5", "integer >= 1"]),
     ({"engine": {"evaluator": "no_such_module:Evaluator"}},
      ["engine.evaluator", "no_such_module"]),
     ({"output": {"band": 1.5}}, ["output.band=1.5"]),
@@ -369,6 +371,50 @@ def test_serial_processes_and_dask_give_the_same_table(tmp_path):
     same_tables(tables["dask"], tables["serial"])
     assert ((tmp_path / "dask" / "results.csv").read_text()
             == (tmp_path / "serial" / "results.csv").read_text())
+
+
+def test_batches_group_the_scenarios_by_log_and_keep_their_order():
+    """Units of at most k, cut from the scenarios ordered by log then id: the same tasks
+    always make the same units."""
+    _, _, scenarios = build_scenarios(sweep.from_dict(fake_config(n=12)))
+    tasks = list(enumerate(scenarios))
+    units = sweep.engines.batches(tasks, 5)
+    assert [len(u) for u in units] == [5, 5, 2]
+    flat = [t for u in units for t in u]
+    assert sorted(i for i, _ in flat) == list(range(12))
+    keys = [(s.log_length_m, s.wood.rho_kg_m3, i) for i, s in flat]
+    assert keys == sorted(keys)
+    assert sweep.engines.batches(tasks[::-1], 5) == units
+    assert sweep.engines.batches(tasks, 1) == [[t] for t in tasks]
+
+
+def test_batched_sweep_gives_the_same_table_and_keeps_the_rows_before_an_error(tmp_path):
+    """engine.batch = 5, with an evaluator that has evaluate_many and with one that has
+    not: the same table as one by one (bitwise), the same counts. A scenario that fails
+    stops the sweep with its error, after the rows of its batch that were computed are
+    written."""
+    one = sweep.run(sweep.from_dict(fake_config(n=12)), out=tmp_path / "one")
+    for name in ("LinearEvaluator", "BatchingEvaluator"):
+        raw = fake_config(n=12, engine={"batch": 5})
+        raw["engine"]["evaluator"] = f"sweep_fakes:{name}"
+        five = sweep.run(sweep.from_dict(raw), out=tmp_path / name)
+        same_tables(table_of(tmp_path / name), table_of(tmp_path / "one"), rtol=0.0)
+        assert five["counts"] == one["counts"], name
+    raw = fake_config(n=12, engine={"batch": 5})
+    raw["engine"]["evaluator"] = "sweep_fakes:BatchingEvaluator"
+    os.environ["SWEEP_FAKE_FAIL_SPEED_ABOVE"] = "3.5"
+    try:
+        with pytest.raises(RuntimeError, match="speed .* above 3.5"):
+            sweep.run(sweep.from_dict(raw), out=tmp_path / "failing")
+    finally:
+        del os.environ["SWEEP_FAKE_FAIL_SPEED_ABOVE"]
+    _, _, scenarios = build_scenarios(sweep.from_dict(raw))
+    units = sweep.engines.batches(list(enumerate(scenarios)), 5)
+    first_bad = next(k for k, u in enumerate(units) if any(s.log_speed_m_s > 3.5 for _, s in u))
+    written = {r[0] for r in table_of(tmp_path / "failing")}
+    expected = {i for u in units[:first_bad] for i, _ in u}
+    expected |= {i for i, s in units[first_bad] if s.log_speed_m_s <= 3.5}
+    assert written == expected and len(written) < 12
 
 
 @pytest.mark.mpi

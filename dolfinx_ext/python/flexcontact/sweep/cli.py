@@ -17,6 +17,8 @@ def add_parser(sub) -> None:
     p.add_argument("--engine", choices=ENGINES, help="overrides engine.kind")
     p.add_argument("--workers", type=int, help="overrides engine.workers")
     p.add_argument("--scheduler", help="Dask scheduler address (engine dask)")
+    p.add_argument("--batch", type=int, help="overrides engine.batch: scenarios stepped side "
+                                             "by side in a worker, sharing the dam's solves")
     m = p.add_mutually_exclusive_group()
     m.add_argument("--model", help="a dam model directory (flexcontact dam prepare) every "
                                    "worker loads instead of factoring the dam; prepared "
@@ -44,7 +46,7 @@ def main(args) -> int:
         return 2
     try:
         cfg = load(args.config)
-        for key in ("workers", "scheduler"):
+        for key in ("workers", "scheduler", "batch"):
             if getattr(args, key) is not None:
                 cfg.engine[key] = getattr(args, key)
         if getattr(args, "model", None):

@@ -18,6 +18,7 @@ Tables and keys (every other key is an error naming it)::
     workers = 2
     scheduler = "tcp://host:8786"  # dask only; none: a LocalCluster
     start_method = "spawn"   # processes: "spawn" | "forkserver"
+    batch = 1                # scenarios stepped side by side, sharing the dam's solves
     [output]
     dir = "results/sweep"    # default results/sweep/<config file's stem>
     plots = true
@@ -50,7 +51,7 @@ ENGINES = ("serial", "processes", "mpi", "dask")
 EVALUATORS = ("reuse", "monolithic")
 _TABLES = {"base", "sample", "parameters", "engine", "output"}
 _SAMPLE = {"method", "n", "seed"}
-_ENGINE = {"evaluator", "kind", "workers", "scheduler", "start_method", "model"}
+_ENGINE = {"evaluator", "kind", "workers", "scheduler", "start_method", "model", "batch"}
 _OUTPUT = {"dir", "plots", "bootstrap", "band"}
 
 
@@ -159,7 +160,8 @@ def _engine(table: dict) -> dict:
     _unknown("engine", table, _ENGINE)
     e = {"evaluator": table.get("evaluator", "reuse"), "kind": table.get("kind", "processes"),
          "workers": table.get("workers"), "scheduler": table.get("scheduler"),
-         "start_method": table.get("start_method", "spawn"), "model": table.get("model")}
+         "start_method": table.get("start_method", "spawn"), "model": table.get("model"),
+         "batch": table.get("batch", 1)}
     ev = e["evaluator"]
     if not isinstance(ev, str) or not (ev in EVALUATORS or ":" in ev):
         raise ConfigError(f"engine.evaluator={ev!r}: must be one of {list(EVALUATORS)} or "
@@ -174,6 +176,7 @@ def check_engine(e: dict) -> None:
         raise ConfigError(f"engine.kind={e['kind']!r}: must be one of {list(ENGINES)}")
     if e["workers"] is not None:
         _int("engine.workers", e["workers"], 1)
+    _int("engine.batch", e.get("batch", 1), 1)
     if e["scheduler"] is not None and not isinstance(e["scheduler"], str):
         raise ConfigError(f"engine.scheduler={e['scheduler']!r}: must be an address string")
     m = e.get("model")

@@ -11,13 +11,20 @@ whichever engine computed it (only the order rows were appended in differs).
 * ``dask``: a ``distributed.Client`` at ``scheduler`` (``tcp://host:8786``), or without
   one a LocalCluster of worker processes, one thread each.
 
-A failing scenario stops the sweep with its error; the rows already written stay.
+With ``batch`` = k > 1 a task is k scenarios that share a log geometry where they can,
+stepped side by side by the evaluator's ``evaluate_many`` (the dam's solves, and the log's,
+made once per step for all of them: docs/architecture.md §7, "Several right-hand sides at
+once"); the batches are cut from the scenarios still to compute in a fixed order, so the
+same run gives the same answers.
+
+A failing scenario stops the sweep with its error; the rows already written stay (in a
+batch, the other scenarios' rows are written first).
 """
 from __future__ import annotations
 
 import os
 
-from .evaluators import evaluate_task, init_worker
+from .evaluators import evaluate_task, evaluate_batch, init_worker
 from ..errors import SolveError
 
 
@@ -36,12 +43,41 @@ def run(engine: dict, spec, tasks: list, on_result, local=None) -> None:
     runner = {"serial": _serial, "processes": _processes, "mpi": _mpi, "dask": _dask}[kind]
     if kind == "serial":
         init_worker(spec, local)
-    runner(engine, spec, tasks, on_result)
+    runner(engine, spec, batches(tasks, engine.get("batch", 1)), _each(on_result))
 
 
-def _serial(engine, spec, tasks, on_result):
-    for t in tasks:
-        on_result(evaluate_task(spec, t))
+def batches(tasks: list, k: int) -> list:
+    """``tasks`` in units of at most ``k``: ordered by log (length, diameter, density, end
+    shape), then by id, and cut in that order, so that a unit's scenarios share their log
+    where the sample allows."""
+    if k <= 1:
+        return [[t] for t in tasks]
+    ordered = sorted(tasks, key=lambda t: (t[1].log_length_m, t[1].log_diameter_m,
+                                           t[1].wood.rho_kg_m3, str(t[1].log_end), t[0]))
+    return [ordered[a:a + k] for a in range(0, len(ordered), k)]
+
+
+def _each(on_result):
+    """on_result for a unit's results: every computed row first, then the first error."""
+    def take(results: list) -> None:
+        failed = [r for r in results if "error" in r]
+        for r in results:
+            if "error" not in r:
+                on_result(r)
+        if failed:
+            raise failed[0]["error"]
+    return take
+
+
+def _evaluate(spec, unit: list) -> list:
+    if len(unit) == 1:
+        return [evaluate_task(spec, unit[0])]
+    return evaluate_batch(spec, unit)
+
+
+def _serial(engine, spec, units, on_results):
+    for u in units:
+        on_results(_evaluate(spec, u))
 
 
 def _drain(futures, on_result, as_completed):
@@ -54,25 +90,25 @@ def _drain(futures, on_result, as_completed):
         raise
 
 
-def _processes(engine, spec, tasks, on_result):
+def _processes(engine, spec, units, on_results):
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
-    n = min(engine["workers"] or default_workers(), len(tasks))
+    n = min(engine["workers"] or default_workers(), len(units))
     ctx = multiprocessing.get_context(engine["start_method"])
     with ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=init_worker,
                              initargs=(spec,)) as pool:
-        _drain([pool.submit(evaluate_task, spec, t) for t in tasks], on_result, as_completed)
+        _drain([pool.submit(_evaluate, spec, u) for u in units], on_results, as_completed)
 
 
-def _mpi(engine, spec, tasks, on_result):
+def _mpi(engine, spec, units, on_results):
     from concurrent.futures import as_completed
     from mpi4py.futures import MPIPoolExecutor
     kwargs = {"max_workers": engine["workers"]} if engine["workers"] else {}
     with MPIPoolExecutor(**kwargs) as pool:
-        _drain([pool.submit(evaluate_task, spec, t) for t in tasks], on_result, as_completed)
+        _drain([pool.submit(_evaluate, spec, u) for u in units], on_results, as_completed)
 
 
-def _dask(engine, spec, tasks, on_result):
+def _dask(engine, spec, units, on_results):
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:
@@ -82,13 +118,13 @@ def _dask(engine, spec, tasks, on_result):
     if engine["scheduler"]:
         client = Client(engine["scheduler"])
     else:
-        n = min(engine["workers"] or default_workers(), len(tasks))
+        n = min(engine["workers"] or default_workers(), len(units))
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = [client.submit(evaluate_task, spec, t, pure=False) for t in tasks]
-        _drain(futures, on_result, as_completed)
+        futures = [client.submit(_evaluate, spec, u, pure=False) for u in units]
+        _drain(futures, on_results, as_completed)
     finally:
         client.close()
         if cluster is not None:

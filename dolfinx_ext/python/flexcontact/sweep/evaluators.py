@@ -149,3 +149,55 @@ def evaluate_task(spec: EvaluatorSpec, task: tuple) -> dict:
     if timed:
         result["timings_s"] = timed
     return result
+
+
+def evaluate_batch(spec: EvaluatorSpec, tasks: list) -> list:
+    """Evaluate several (id, scenario) side by side in this process, by the evaluator's
+    ``evaluate_many`` (one after the other if it has none): per task, its result as
+    :func:`evaluate_task` gives it, or {"id", "error"} for a scenario that failed. The
+    counts and timings the batch added go to its first computed row (the summary sums
+    them); each row's seconds are the batch's wall time shared equally."""
+    if _STATE.get("spec") != spec:
+        init_worker(spec)
+    ev = _STATE["evaluator"]
+    if not hasattr(ev, "evaluate_many"):
+        out = []
+        for t in tasks:
+            try:
+                out.append(evaluate_task(spec, t))
+            except Exception as err:  # noqa: BLE001: reported with the others
+                out.append({"id": t[0], "error": err})
+        return out
+    t0 = time.perf_counter()
+    results = ev.evaluate_many([s for _, s in tasks])
+    seconds = (time.perf_counter() - t0) / len(tasks)
+    worker = f"{socket.gethostname()}:{os.getpid()}"
+    now = ev.counts()
+    delta = _delta(now, _STATE["reported"])
+    _STATE["reported"] = now
+    timed_batch = {}
+    if hasattr(ev, "timings"):
+        t = {k: float(v) for k, v in ev.timings().items()}
+        timed_batch = {k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()}
+        _STATE["timed"] = t
+    out, first = [], True
+    for (i, _), res in zip(tasks, results):
+        if isinstance(res, BaseException):
+            out.append({"id": i, "error": res})
+            continue
+        outputs = dict(res)
+        timed = {k: float(outputs.pop(k)) for k in TIMING_OUTPUTS if k in outputs}
+        row = {"id": i, "outputs": outputs, "seconds": seconds, "worker": worker,
+               "counts": delta if first else _zero_like(delta)}
+        if first:
+            timed.update(timed_batch)
+        if timed:
+            row["timings_s"] = timed
+        first = False
+        out.append(row)
+    return out
+
+
+def _zero_like(counts: dict) -> dict:
+    return {kind: {k: 0 for k in v} for kind, v in counts.items()}
+
