@@ -24,7 +24,6 @@ Writes bench/batched_solves.json.
 import argparse
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -41,18 +40,10 @@ ap.add_argument("--out", default=str(Path(__file__).with_name("batched_solves.js
 args = ap.parse_args()
 sys.path.insert(0, str(ROOT / "bench"))
 from machine import machine  # noqa: E402
+from timing import median_time as median_s  # noqa: E402
 
 KS = (1, 2, 4, 8, 16)
 STEPS = {"dam": 147, "log": 147, "log_flight": 169}  # the main job's what-if, per scenario
-
-
-def median_s(call, runs: int) -> float:
-    times = []
-    for _ in range(runs):
-        t0 = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 def single(factor, new_vector, plain: bool, B: np.ndarray):
