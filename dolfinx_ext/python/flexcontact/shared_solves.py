@@ -14,7 +14,8 @@ expansion next: the stepper's protocol), then the plain solves, then the condens
 A run that fails between its condensation and its expansion leaves a zero column in the
 expansion of the others. Which runs share a call depends only on the runs themselves, so
 the same runs give the same answers; a run's answers differ from its answers alone by
-round-off only (MUMPS's blocked kernels sum in another order for several columns).
+round-off (MUMPS's blocked kernels sum in another order for several columns), which a
+contact step's index set can amplify (docs/dam.md, "Sweeps").
 """
 from __future__ import annotations
 
