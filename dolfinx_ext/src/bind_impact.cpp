@@ -10,6 +10,7 @@
 #include "bindings.h"
 #include "factor_operator.h"
 
+#include <flexcontact/dense_blocks.hpp>
 #include <flexcontact/impact.hpp>
 #include <flexcontact/increment.hpp>
 
@@ -64,7 +65,7 @@ py::dict step_dict(const ImpactStep& r, int dim)
 using DofArray = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
 
 /// @brief The factor path's impact object with the PETSc operator it calls, kept alive
-/// together.
+/// together (dense_blocks: the blocks are kept alive by the operator itself).
 struct FactorImpact
 {
   std::shared_ptr<FactorFlexibility> flexibility;
@@ -160,10 +161,29 @@ void flexcontact::bind_impact(py::module& m)
       .def("contact_dofs", &ImpactContact::contact_dofs)
       .def("dim", &ImpactContact::dim);
 
+  py::class_<DenseBlock, std::shared_ptr<DenseBlock>>(
+      m, "DenseBlock",
+      "One body's dense flexibility block F (n x n), held once and shared by the runs that "
+      "use it (FactorImpact.dense_blocks): a sweep's dam face, or a log in its own frame.")
+      .def(py::init<Matrix>(), py::arg("F"))
+      .def_property_readonly("rows", &DenseBlock::rows)
+      .def_property_readonly("symmetric", &DenseBlock::symmetric,
+                             "True: a product with one whole column reads the lower triangle only")
+      .def(
+          "product",
+          [](const DenseBlock& b, const Matrix& X)
+          {
+            py::gil_scoped_release release;
+            return b.product(X);
+          },
+          py::arg("X"),
+          "F X for X of n rows (k columns at once: F is read once for all of them)");
+
   py::class_<FactorImpact>(
       m, "FactorImpact",
       "The factor path of the Moreau-Jean contact step: Fhat applied through the factor of "
-      "What by blocks of right-hand sides, W_eff's columns of the index set fetched and held; "
+      "What by blocks of right-hand sides (or through shared DenseBlocks: dense_blocks), "
+      "W_eff's columns of the index set fetched and held; "
       "neither Fhat nor W_eff is formed. Collective: build and step it on every rank with the "
       "same arguments.")
       .def(py::init(
@@ -189,6 +209,34 @@ void flexcontact::bind_impact(py::module& m)
            "factor, What: petsc4py Mat.handle of the factored What and of What (for its "
            "layout); dofs: global indices of the real contact DOFs (the same on every rank); "
            "working_set_bytes: memory for W_eff's columns of the index set")
+      .def_static(
+          "dense_blocks",
+          [](int dim, std::vector<std::shared_ptr<DenseBlock>> blocks,
+             std::vector<std::optional<Matrix>> rotations, Matrix X,
+             std::vector<ContactPair> pairs, Vector mu, double e, double dt, double theta,
+             const SolverOptions& options, double max_bytes)
+          {
+            std::vector<Matrix> turn;
+            for (auto& q : rotations)
+              turn.push_back(q ? *q : Matrix());
+            auto F = std::make_shared<const SharedBlocks>(
+                dim, std::vector<std::shared_ptr<const DenseBlock>>(blocks.begin(), blocks.end()),
+                std::move(turn));
+            FactorImpact c;
+            c.contact = std::make_unique<ImpactContact>(
+                dim, [F](const Matrix& R) { return F->apply(R); }, std::move(X),
+                std::move(pairs), std::move(mu), e, dt, theta, std::vector<bool>(), options,
+                max_bytes);
+            return c;
+          },
+          py::arg("dim"), py::arg("blocks"), py::arg("rotations"), py::arg("X"),
+          py::arg("pairs"), py::arg("mu"), py::arg("restitution"), py::arg("dt_s"),
+          py::arg("theta") = 0.5, py::arg("options") = SolverOptions(),
+          py::arg("working_set_bytes") = 0.0,
+          "The factor path with Fhat = diag(Q_b F_b Q_b^T) over shared DenseBlocks (Q_b: a "
+          "d x d rotation of the block's nodes into the run's frame, or None): neither Fhat "
+          "nor W_eff is formed, W_eff's columns of the index set are fetched from the "
+          "blocks. step() takes v_free = v + Fhat b from the caller. Serial.")
       .def(
           "step",
           [convergence_error](FactorImpact& c, const Vector& u_c, const Vector& v_c,
