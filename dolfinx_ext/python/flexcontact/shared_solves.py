@@ -3,7 +3,9 @@ factor can have it read once for all of them (docs/architecture.md §7, "Several
 sides at once").
 
 A run written as a generator yields a list of solves (``Condense``, ``Expand``, ``Solve``)
-and gets back, in the same order, what each returns. :func:`serve_alone` serves them one by
+and gets back, in the same order, what each returns. A condensation can ask for its
+product with the body's dense F̂ block as well: runs that share the block share that
+product, one matrix product for all their columns. :func:`serve_alone` serves them one by
 one: that is a run's ordinary execution. :func:`serve_together` drives several runs in
 lockstep: each round it serves every live run's list, the solves of one factor in one call
 (``condense_many``, ``expand_many``, ``solve_many``), and sends each run its answers.
@@ -29,9 +31,13 @@ from petsc4py import PETSc
 
 @dataclass
 class Condense:
-    """b̃_c of b (returns the factor's condensation, an array)."""
+    """b̃_c of b (returns the factor's condensation, an array). With ``block`` (the body's
+    F̂ block, a ``_cpp.DenseBlock``), returns (b̃_c, F̂ b̃_c): the product that the kernel
+    step would otherwise make, made here so that runs sharing the block read it once
+    (stepper.BodiesStepper)."""
     factor: object
     b: PETSc.Vec
+    block: Optional[object] = None
 
 
 @dataclass
@@ -52,7 +58,8 @@ class Solve:
 
 def _serve_one(op):
     if isinstance(op, Condense):
-        return op.factor.condense(op.b)
+        c = np.asarray(op.factor.condense(op.b))
+        return c if op.block is None else (c, _product(op.block, c[:, None])[:, 0])
     if isinstance(op, Expand):
         op.factor.expand(op.local, op.y)
         return None
@@ -83,9 +90,10 @@ class Together:
     ("runs": their kernel steps, right-hand sides and outputs)."""
 
     def __init__(self):
-        self.calls = {"condense": 0, "expand": 0, "solve": 0}
-        self.columns = {"condense": 0, "expand": 0, "solve": 0}
-        self.seconds = {"condense": 0.0, "expand": 0.0, "solve": 0.0, "runs": 0.0}
+        self.calls = {"condense": 0, "expand": 0, "solve": 0, "product": 0}
+        self.columns = {"condense": 0, "expand": 0, "solve": 0, "product": 0}
+        self.seconds = {"condense": 0.0, "expand": 0.0, "solve": 0.0, "product": 0.0,
+                        "runs": 0.0}
 
     def count(self, kind: str, columns: int) -> None:
         self.calls[kind] += 1
@@ -124,10 +132,10 @@ def serve_together(runs: Sequence[Generator], stats: Optional[Together] = None) 
         t1 = time.perf_counter()
         for items in by_kind[Solve].values():
             _solve(items, answers, stats)
-        t2 = time.perf_counter()
+        t2, products = time.perf_counter(), stats.seconds["product"]
         for key, items in by_kind[Condense].items():
             pending[key] = _condense(items, answers, stats)
-        t3 = time.perf_counter()
+        t3 = time.perf_counter() - (stats.seconds["product"] - products)
         for kind, dt in (("expand", t1 - t0), ("solve", t2 - t1), ("condense", t3 - t2)):
             stats.seconds[kind] += dt
         for i in sorted(round_):
@@ -142,15 +150,32 @@ def _condense(items, answers, stats) -> Optional[list]:
             raise RuntimeError(f"{len(items)} runs condense on one factor that holds a single "
                                "pending condensation; serve them alone")
         i, j, op = items[0]
-        answers[i][j] = factor.condense(op.b)
+        C = np.asarray(factor.condense(op.b))[:, None]
         stats.count("condense", 1)
-        return None
-    B = np.asfortranarray(np.column_stack([op.b.array_r for _, _, op in items]))
-    C = factor.condense_many(B)
-    stats.count("condense", len(items))
+        members = None
+    else:
+        B = np.asfortranarray(np.column_stack([op.b.array_r for _, _, op in items]))
+        C = factor.condense_many(B)
+        stats.count("condense", len(items))
+        members = [i for i, _, _ in items]
+    blocks = {id(op.block): op.block for _, _, op in items if op.block is not None}
+    FC = {}
+    if blocks:
+        t0 = time.perf_counter()
+        for key, block in blocks.items():
+            cols = [col for col, (_, _, op) in enumerate(items) if id(op.block) == key]
+            Y = _product(block, np.asfortranarray(C[:, cols]))
+            FC.update({col: Y[:, a] for a, col in enumerate(cols)})
+            stats.count("product", len(cols))
+        stats.seconds["product"] += time.perf_counter() - t0
     for col, (i, j, _) in enumerate(items):
-        answers[i][j] = np.array(C[:, col])
-    return [i for i, _, _ in items]
+        c = np.array(C[:, col])
+        answers[i][j] = (c, np.array(FC[col])) if col in FC else c
+    return members
+
+
+def _product(block, X: np.ndarray) -> np.ndarray:
+    return np.asarray(block.product(X))
 
 
 def _expand(items, members: Optional[list], stats) -> None:

@@ -221,7 +221,10 @@ class CondensedBody:
     ``solve``); ``dofs`` are the indices of the body's contact DOFs in its own vectors,
     node-major, in the order of its block of the kernel's flexibility; ``rotation`` (d × d)
     takes the body's own frame to the kernel's (None: the same frame); ``new_vector`` makes
-    a zeroed vector of the body; ``counted`` is told of each back-substitution.
+    a zeroed vector of the body; ``counted`` is told of each back-substitution;
+    ``flexibility``: the body's F̂ block in its own frame as a ``_cpp.DenseBlock``, for a
+    kernel object that leaves the products with F̂ to the stepper
+    (``FactorImpact.dense_blocks``).
     """
 
     name: str
@@ -230,6 +233,7 @@ class CondensedBody:
     new_vector: Callable[[], PETSc.Vec]
     rotation: Optional[np.ndarray] = None
     counted: Optional[Callable[[], None]] = None
+    flexibility: Optional[object] = None
 
 
 class BodiesStepper:
@@ -241,6 +245,12 @@ class BodiesStepper:
     with a factor that splits, split around one kernel step (``step_condensed``). A body
     whose right-hand side is None is at rest: it costs nothing, and its y is None, unless an
     impulse reaches it (then A_b⁻¹ S_bᵀ r_b). Serial (each body's vectors on one process).
+
+    When every body brings its ``flexibility`` block and splits, the products with F̂ are
+    made here, each in the body's own frame: F̂ b̃ with the condensation (runs that share a
+    block share that product, shared_solves), the free velocity v + F̂ b̃ for the kernel step
+    (``step(u, v, v_free)`` of a ``FactorImpact.dense_blocks``), F̂ r after it, and the
+    expansion takes F̂ (b̃ + r).
     """
 
     def __init__(self, kernel, bodies: Sequence[CondensedBody], *, expand_key: str):
@@ -292,6 +302,8 @@ class BodiesStepper:
         making them, and returns advance's value: driven by shared_solves.serve_together,
         several runs sharing a body's factor share its calls."""
         split = self.split
+        if split and all(b.flexibility is not None for b in self.bodies):
+            return (yield from self._advance_outside(rhs, where, before, after, free_shift))
         ops, free = [], []
         for body, b in zip(self.bodies, rhs):
             if b is None:
@@ -315,27 +327,62 @@ class BodiesStepper:
         values = np.concatenate(values)
         if not split and free_shift is not None:
             values = values + free_shift
-        step = self.kernel.step_condensed if split else self.kernel.step
-        try:
-            out = step(*before, values, *after)
-        except ConvergenceError as err:
-            error = ConvergenceError(f"{where}: {err}")
-            error.report = dict(getattr(err, "report", {}))
-            error.problem_path = getattr(err, "problem_path", None)
-            raise error from None
-        self.crossings += 1
+        out = self._kernel_step(self.kernel.step_condensed if split else self.kernel.step,
+                                (*before, values, *after), where)
         key = self.expand_key if split else "reaction"
         change = np.asarray(out[key])
         first, second, spent, ys = [], [], [], []
         for body, b, part, y0 in zip(self.bodies, rhs, self._slices, free):
             local = self._from_kernel(body, change[part])
             ys.append(self._body_solution(body, b, local, y0, split, first, second, spent))
+        yield from self._expansions(first, second, spent)
+        return out, ys
+
+    @staticmethod
+    def _expansions(first, second, spent):
+        """Yields the bodies' solves after the kernel step, then frees their temporaries."""
         if first:
             yield first
         if second:
             yield second
         for v in spent:
             v.destroy()
+
+    def _kernel_step(self, step, args, where: str) -> dict:
+        try:
+            out = step(*args)
+        except ConvergenceError as err:
+            error = ConvergenceError(f"{where}: {err}")
+            error.report = dict(getattr(err, "report", {}))
+            error.problem_path = getattr(err, "problem_path", None)
+            raise error from None
+        self.crossings += 1
+        return out
+
+    def _advance_outside(self, rhs, where, before, after, free_shift):
+        """advance_requests with the products of F̂ made here (see the class)."""
+        loaded = [i for i, b in enumerate(rhs) if b is not None]
+        asks = [Condense(self.bodies[i].factor, rhs[i], self.bodies[i].flexibility)
+                for i in loaded]
+        answers = iter((yield asks) if asks else ())
+        Fb = [np.zeros(b.dofs.size) for b in self.bodies]
+        for i in loaded:
+            Fb[i] = next(answers)[1]
+        vfree = np.concatenate([self._to_kernel(b, f) for b, f in zip(self.bodies, Fb)])
+        if free_shift is not None:
+            vfree = vfree + free_shift
+        out = self._kernel_step(self.kernel.step, (*before, vfree, *after), where)
+        reaction = np.asarray(out["reaction"])
+        first, second, spent, ys, change = [], [], [], [], []
+        for body, b, part, fb in zip(self.bodies, rhs, self._slices, Fb):
+            r = self._from_kernel(body, reaction[part])
+            # r lives on the closed pairs' nodes: the block's product reads their columns.
+            local = fb + (np.asarray(body.flexibility.product(r[:, None]))[:, 0]
+                          if np.any(r != 0.0) else 0.0)
+            change.append(self._to_kernel(body, local))
+            ys.append(self._body_solution(body, b, local, None, True, first, second, spent))
+        out[self.expand_key] = np.concatenate(change)
+        yield from self._expansions(first, second, spent)
         return out, ys
 
     def _body_solution(self, body, b, local, y0, split, first, second,

@@ -2,10 +2,12 @@
 through contact (docs/architecture.md §7, per-body condensation).
 
 The contact nodes are the placed log's front-end nodes (slaves, first) and the nodes of the
-dam's face strip (masters, node–surface, paired once as stage 2 does). The kernel's F is
-block-diagonal, [F̂_log (rotated), F̂_face], so ``_cpp.ImpactContact`` is used unchanged, and
-each Moreau–Jean step (θ-scheme, dynamics.py) goes through the stepper for separately
-condensed bodies (stepper.BodiesStepper):
+dam's face strip (masters, node–surface, paired once as stage 2 does). The kernel's F̂ is
+block-diagonal, [F̂_log (rotated), F̂_face]: in 3D (``fhat``, :data:`FHAT`) the kernel holds
+the two models' blocks, shared by every scenario, and the stepper makes the products with
+them (docs/architecture.md §7, "Blocks shared between runs"). Each Moreau–Jean step
+(θ-scheme, dynamics.py) goes through the stepper for separately condensed bodies
+(stepper.BodiesStepper):
 
 1. each body's right-hand side h[−K (w + hθ ω)], condensed onto its contact DOFs with its
    own factor, skipped while the body has received no impulse (it is then exactly at
@@ -29,7 +31,7 @@ from ..condensation import kernel_pairs
 from ..pairing import pair_caps
 from ..impact_output import contact_metrics, filter_steps, force_at_filtered_peak
 from ..postprocess import impact_step_forces, peak_pressure_Pa
-from ..shared_solves import Solve, serve_alone
+from ..shared_solves import Solve, serve_alone, shares
 from ..stepper import BodiesStepper, CondensedBody
 from ..surface_pairs import build_surface_pairs
 from .key_numbers import halfspace_tension_Pa
@@ -98,17 +100,50 @@ response functions, dam/response.py: no dam back-substitution) or "step" (the da
 to the end)."""
 
 
+FHAT = ("auto", "shared", "dense")
+"""How the kernel holds F̂ = diag(F̂_log, F̂_face): "shared" (the log's and the face's blocks,
+held once by their models and shared by every scenario, the log's turned by its placement;
+W_eff's columns fetched for the pairs that close), "dense" (F̂ and W_eff formed whole for
+each scenario: 380 MB at the main job's mesh) or "auto": "shared" where the dam's factor
+shares its solves between scenarios (MUMPS's Schur factor: the 3D block), "dense" for a
+split factor (the 2D section, whose blocks are a few hundred DOFs: there the stepper's
+products cost more than the kernel's, 0.23 s against 0.14 s a scenario)."""
+
+
+def holds_shared_blocks(fhat: str, dam) -> bool:
+    """Whether a run with ``fhat`` (:data:`FHAT`) on ``dam`` holds the models' blocks."""
+    if fhat not in FHAT:
+        raise ValueError(f"fhat={fhat!r}: one of {FHAT}")
+    return fhat == "shared" or (fhat == "auto" and shares(dam.factor))
+
+
+def _kernel(d, dam, log, R, pairs, mu: float, h: float, theta: float, shared: bool):
+    m = pairs.m
+    if shared:
+        # Room for every pair's columns of W_eff: the index set never asks for more.
+        room = 8.0 * (d * m) ** 2 + 1.0
+        return _cpp.FactorImpact.dense_blocks(
+            d, [log.front_block, dam.face_block], [R, None], pairs.x, kernel_pairs(pairs),
+            np.full(m, mu), 0.0, h, theta, _cpp.SolverOptions(), room)
+    # Column-major, as the kernel holds it: handed over by a plain copy, not a transpose.
+    F = np.zeros((d * pairs.x.shape[0],) * 2, order="F")
+    F[:d * m, :d * m] = log.W_front_global(R)
+    F[d * m:, d * m:] = dam.W_face
+    return _cpp.ImpactContact(d, F, pairs.x, kernel_pairs(pairs), np.full(m, mu), 0.0, h,
+                              theta, None, _cpp.SolverOptions())
+
+
 def run_impact(dam, log, s, static, offset_m: float = 1.0,
                after_contact: str = "convolve", histories: bool = False,
-               timings: Optional[dict] = None) -> dict:
+               timings: Optional[dict] = None, fhat: str = "auto") -> dict:
     """The impact of scenario ``s`` alone (:func:`impact_run`, its solves made one by one)."""
     return serve_alone(impact_run(dam, log, s, static, offset_m, after_contact, histories,
-                                  timings))
+                                  timings, fhat))
 
 
 def impact_run(dam, log, s, static, offset_m: float = 1.0,
                after_contact: str = "convolve", histories: bool = False,
-               timings: Optional[dict] = None):
+               timings: Optional[dict] = None, fhat: str = "auto"):
     """The impact of scenario ``s`` (a DamScenario) from the static state ``static`` of
     ``dam`` at its water level, with ``log`` (the LogModel of its log), as a generator of
     its solves (shared_solves: served alone by :func:`run_impact`, or beside other
@@ -122,23 +157,21 @@ def impact_run(dam, log, s, static, offset_m: float = 1.0,
     impulses with its response functions. Should the log come back within that bound, the
     dam is stepped again from where it stopped (its back-substitutions counted).
 
+    ``fhat``: how the kernel holds F̂ (:data:`FHAT`).
+
     ``timings``: a dict to which the seconds of the steps with the dam stepped
     ("coupled_steps_s"), of those with the log alone ("log_only_steps_s") and of the
     convolution ("convolution_s") are added (wall time: beside other runs, theirs too)."""
     if after_contact not in AFTER_CONTACT:
         raise ValueError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
     h, theta, d = dam.dt, dam.theta, s.dim
+    shared = holds_shared_blocks(fhat, dam)
     R = log.placement(s)
     slave = log.placed_front(R, s.log_centre)
     pairs = build_surface_pairs([("node_to_surface", slave, dam.face)], d)
     m = pairs.m
-    # Column-major, as the kernel holds it: handed over by a plain copy, not a transpose.
-    F = np.zeros((d * pairs.x.shape[0],) * 2, order="F")
     n_log = d * m
-    F[:n_log, :n_log] = log.W_front_global(R)
-    F[n_log:, n_log:] = dam.W_face
-    kernel = _cpp.ImpactContact(d, F, pairs.x, kernel_pairs(pairs), np.full(m, s.friction_mu),
-                                0.0, h, theta, None, _cpp.SolverOptions())
+    kernel = _kernel(d, dam, log, R, pairs, s.friction_mu, h, theta, shared)
     sigma_c = log_crushing_strength_Pa(s)
     if sigma_c is not None:
         pairs.crushing_strength = np.full(m, sigma_c)
@@ -158,9 +191,12 @@ def impact_run(dam, log, s, static, offset_m: float = 1.0,
     # the models' own counters also count theirs)
     stepper = BodiesStepper(kernel, [
         CondensedBody("log", log.factor, log.front_dofs, log.new_vector, rotation=R,
-                      counted=_log_solve_counter(log)),
+                      counted=_log_solve_counter(log),
+                      flexibility=log.front_block if shared else None),
         CondensedBody("dam", dam.factor, dam.face_dofs, dam.new_vector,
-                      counted=_dam_solve_counter(dam))], expand_key="velocity_change_c")
+                      counted=_dam_solve_counter(dam),
+                      flexibility=dam.face_block if shared else None)],
+        expand_key="velocity_change_c")
     dam_slice = slice(n_log, n_log + dam.face_dofs.size)   # the kernel's DOFs: log, then dam
     face_x = pairs.x[m:, 0] + u_face0[0::d]   # the face nodes' static x (m)
     stopped, touched, last_contact = None, False, -1

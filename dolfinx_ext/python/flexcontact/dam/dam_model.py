@@ -284,6 +284,14 @@ class DamModel:
             self.flex_info = dict(info)
         self.timings["stage2_factor_s"] = time.perf_counter() - t0
 
+    @property
+    def face_block(self):
+        """W_face as the kernel's shared block (``_cpp.DenseBlock``), made once for every
+        scenario of this model."""
+        if getattr(self, "_face_block", None) is None:
+            self._face_block = _cpp.DenseBlock(np.asfortranarray(self.W_face))
+        return self._face_block
+
     def _strip_tags(self):
         """MeshTags of the upstream-face facets inside the strip (their midpoints)."""
         msh, ft = self.mesh.msh, self.mesh.facet_tags

@@ -317,6 +317,14 @@ class LogModel:
     def W_front_global(self, R: np.ndarray) -> np.ndarray:
         return rotate_blocks(self.W_front, R)
 
+    @property
+    def front_block(self):
+        """W_front as the kernel's shared block (``_cpp.DenseBlock``), made once: every
+        placement of this log uses it through its rotation, with no rotated copy."""
+        if getattr(self, "_front_block", None) is None:
+            self._front_block = _cpp.DenseBlock(np.asfortranarray(self.W_front))
+        return self._front_block
+
     def free_factor(self):
         """The factor of a step without contact: the plain one where the log has one, else
         its contact factor."""

@@ -26,7 +26,7 @@ from mpi4py import MPI
 
 from .. import impact_setup as setup
 from ..shared_solves import Together, serve_alone, serve_together, shares
-from .coupled_step import AFTER_CONTACT, expected_contact_s, impact_run, run_impact
+from .coupled_step import AFTER_CONTACT, FHAT, expected_contact_s, impact_run, run_impact
 from .dam_model import DamModel, front_end_span_m
 from .log_model import LogMesh, LogModel, contact_ball
 from .scenario import DamScenario
@@ -144,7 +144,8 @@ class ScenarioEvaluator:
     ``offset_m``:
     the distance from the first-contact point at which the peak principal stress is read;
     ``after_contact``: "convolve" (default: the dam is not stepped once the log has left it
-    for good, the base section then comes from its response functions) or "step".
+    for good, the base section then comes from its response functions) or "step";
+    ``fhat``: how each scenario's kernel holds F̂ (coupled_step.FHAT; default "auto").
     """
 
     def __init__(self, base: DamScenario, dt_s: Optional[float] = None,
@@ -152,7 +153,8 @@ class ScenarioEvaluator:
                  comm: MPI.Comm = MPI.COMM_SELF, *,
                  strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0,
                  patch_y_m: Optional[tuple[float, float]] = None,
-                 after_contact: str = "convolve", dam: Optional[DamModel] = None):
+                 after_contact: str = "convolve", dam: Optional[DamModel] = None,
+                 fhat: str = "auto"):
         if base.westergaard:
             raise InputError("westergaard=True: the reservoir's added mass depends on the water "
                              "level, so one factored dam cannot serve a sweep over it; use the "
@@ -161,7 +163,10 @@ class ScenarioEvaluator:
             raise InputError(f"offset_m={offset_m!r}: must be > 0 m")
         if after_contact not in AFTER_CONTACT:
             raise InputError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
+        if fhat not in FHAT:
+            raise InputError(f"fhat={fhat!r}: one of {FHAT}")
         self.base, self.offset_m, self.after_contact = base, float(offset_m), after_contact
+        self.fhat = fhat
         self.dt = (dam.dt if dam is not None else
                    float(dt_s) if dt_s is not None else sweep_time_step_s([base]))
         t0 = time.perf_counter()
@@ -219,7 +224,7 @@ class ScenarioEvaluator:
         static = self.dam.static_state(scenario.water_level_m)
         t0 = time.perf_counter()
         out = run_impact(self.dam, log, scenario, static, self.offset_m, self.after_contact,
-                         timings=self._split)
+                         timings=self._split, fhat=self.fhat)
         out["evaluate_s"] = time.perf_counter() - t0
         self._steps_s += out["evaluate_s"]
         return out
@@ -244,7 +249,8 @@ class ScenarioEvaluator:
             except Exception as err:  # noqa: BLE001: the scenario's failure is its result
                 results[k] = err
                 continue
-            runs.append(impact_run(self.dam, log, s, static, self.offset_m, self.after_contact))
+            runs.append(impact_run(self.dam, log, s, static, self.offset_m, self.after_contact,
+                                   fhat=self.fhat))
             where.append(k)
         together = shares(self.dam.factor) and all(
             shares(self.log_model(scenarios[k]).factor) for k in where)
