@@ -24,7 +24,6 @@ Writes bench/batched_solves.json.
 import argparse
 import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -40,6 +39,7 @@ ap.add_argument("--out", default=str(Path(__file__).with_name("batched_solves.js
 args = ap.parse_args()
 sys.path.insert(0, str(ROOT / "bench"))
 from machine import machine  # noqa: E402
+from main_job_model import main_job_model  # noqa: E402
 from timing import median_time as median_s  # noqa: E402
 
 KS = (1, 2, 4, 8, 16)
@@ -106,14 +106,7 @@ def main(model: Path) -> dict:
 
 
 with tempfile.TemporaryDirectory() as tmp:
-    model = Path(args.model) if args.model else Path(tmp) / "model"
-    prepare_s = None
-    if not args.model:
-        t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "flexcontact", "dam", "prepare",
-                        str(ROOT / "examples/dam_model_main_job.toml"), "--out", str(model)],
-                       check=True, cwd=ROOT, capture_output=True)
-        prepare_s = time.perf_counter() - t0
+    model, prepare_s = main_job_model(args.model, tmp)
     load_before = os.getloadavg()[0]
     result = main(model)
     result.update({"runs": args.runs, "prepare_s": prepare_s,

@@ -67,6 +67,7 @@ if args.one:
 
 sys.path.insert(0, str(ROOT / "bench"))
 from machine import machine  # noqa: E402
+from main_job_model import main_job_model  # noqa: E402
 
 
 def measure(model: Path) -> dict:
@@ -101,14 +102,7 @@ def measure(model: Path) -> dict:
 
 
 with tempfile.TemporaryDirectory() as tmp:
-    model = Path(args.model) if args.model else Path(tmp) / "model"
-    prepare_s = None
-    if not args.model:
-        t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "flexcontact", "dam", "prepare",
-                        str(ROOT / "examples/dam_model_main_job.toml"), "--out", str(model)],
-                       check=True, cwd=ROOT, capture_output=True)
-        prepare_s = time.perf_counter() - t0
+    model, prepare_s = main_job_model(args.model, tmp)
     load_before = os.getloadavg()[0]
     result = measure(model)
     result.update({"what": "the main job's scenario alone and k side by side, with F̂ formed "
