@@ -130,3 +130,18 @@ def test_wheel_installs_complete_and_runs_outside_the_checkout(tmp_path):
     rows = (work / "sweep" / "results.jsonl").read_text().splitlines()
     assert len(rows) == 2
     assert (work / "sweep" / "results.csv").is_file()
+
+
+def test_the_suite_runs_this_checkout_whichever_clone_is_registered():
+    """The tests import this checkout's package with its forms/ and meshes/, and so do
+    their subprocesses, even when scripts/setup.sh of another clone registered that clone
+    for /usr/bin/python3 last (tests/conftest.py)."""
+    import flexcontact
+    from flexcontact import forms, meshes
+    for module in (flexcontact, forms, meshes):
+        assert Path(module.__file__).resolve().is_relative_to(ROOT), module.__file__
+    code = ("import flexcontact, flexcontact.forms, flexcontact.meshes as m; "
+            "print(flexcontact.__file__); print(m.__file__)")
+    out = subprocess.run([PYTHON, "-c", code], cwd="/", capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert [Path(p).resolve().is_relative_to(ROOT) for p in out] == [True, True], out
