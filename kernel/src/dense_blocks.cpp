@@ -48,7 +48,7 @@ Matrix stream_product(const Matrix& F, const Matrix& X)
 }
 
 /// Every node's d rows of Y, Y_node ← A Y_node (A = Q into the run's frame, Qᵀ out of it).
-void turn_nodes(Eigen::Ref<Matrix> Y, const Matrix& A)
+void turn_nodes(Matrix& Y, const Matrix& A)
 {
   const Eigen::Index d = A.rows();
   for (Eigen::Index a = 0; a < Y.rows(); a += d)
@@ -168,8 +168,9 @@ Matrix SharedBlocks::apply(const Matrix& R) const
     // product still reads only the nonzero nodes' columns.
     Matrix local = R.middleRows(a, s);
     turn_nodes(local, Q.transpose());
-    Y.middleRows(a, s) = blocks_[b]->product(local);
-    turn_nodes(Y.middleRows(a, s), Q);
+    Matrix Yb = blocks_[b]->product(local);
+    turn_nodes(Yb, Q);
+    Y.middleRows(a, s) = Yb;
   }
   return Y;
 }
