@@ -15,14 +15,8 @@ import gmsh  # noqa: F401
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "dolfinx_ext" / "python"))
-# Another clone registered for /usr/bin/python3 (scripts/setup.sh's .pth) has imported its
-# own flexcontact_checkout at start-up, whose finder maps forms/ and meshes/ for that
-# clone's package only: this checkout's takes its place. Subprocesses (demos, the command
-# line) find this checkout first too.
-_other = sys.modules.get("flexcontact_checkout")
-if _other is not None and Path(_other.__file__).resolve().parents[2] != ROOT:
-    sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _other.CheckoutFinder)]
-    del sys.modules["flexcontact_checkout"]
+# Subprocesses (demos, the command line) find this checkout first too, not the clone that
+# scripts/setup.sh registered for /usr/bin/python3 last.
 os.environ["PYTHONPATH"] = os.pathsep.join(
     [str(ROOT / "dolfinx_ext" / "python")]
     + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])

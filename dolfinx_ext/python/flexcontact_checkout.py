@@ -15,21 +15,31 @@ import importlib.util
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-SUBPACKAGES = {"flexcontact.forms": ROOT / "forms", "flexcontact.meshes": ROOT / "meshes"}
+SUBPACKAGES = {"flexcontact.forms": "forms", "flexcontact.meshes": "meshes"}
+
+
+def checkout_of(package_dir: Path):
+    """The checkout whose ``dolfinx_ext/python/flexcontact`` is ``package_dir``, or None
+    (an installed wheel, which brings its own subpackages)."""
+    if package_dir.name == "flexcontact" and package_dir.parent.name == "python" \
+            and package_dir.parent.parent.name == "dolfinx_ext":
+        return package_dir.parents[2]
+    return None
 
 
 class CheckoutFinder(importlib.abc.MetaPathFinder):
-    """Finds ``flexcontact.forms`` and ``flexcontact.meshes`` in the checkout's folders."""
+    """Finds ``flexcontact.forms`` and ``flexcontact.meshes`` in the folders of the checkout
+    that the imported ``flexcontact`` comes from, whichever clone registered this finder
+    (several clones may be on one machine, one of them registered by its .pth)."""
 
     def find_spec(self, name, path=None, target=None):
-        folder = SUBPACKAGES.get(name)
-        if folder is None or not (folder / "__init__.py").is_file():
-            return None
-        # Only for this checkout's package: an installed wheel brings its own subpackages.
+        sub = SUBPACKAGES.get(name)
         parent = sys.modules.get("flexcontact")
-        home = Path(getattr(parent, "__file__", "") or "").resolve().parent
-        if home != ROOT / "dolfinx_ext" / "python" / "flexcontact":
+        if sub is None or parent is None:
+            return None
+        root = checkout_of(Path(getattr(parent, "__file__", "") or "").resolve().parent)
+        folder = None if root is None else root / sub
+        if folder is None or not (folder / "__init__.py").is_file():
             return None
         return importlib.util.spec_from_file_location(
             name, folder / "__init__.py", submodule_search_locations=[str(folder)])
