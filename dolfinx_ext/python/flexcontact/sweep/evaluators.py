@@ -125,6 +125,19 @@ def _delta(now: dict, before: dict) -> dict:
             if kind in now or kind != "restorations"}
 
 
+def _added(ev) -> tuple:
+    """(counts, timings) that ``ev`` added since this process last reported them."""
+    now = ev.counts()
+    delta = _delta(now, _STATE["reported"])
+    _STATE["reported"] = now
+    timed = {}
+    if hasattr(ev, "timings"):
+        t = {k: float(v) for k, v in ev.timings().items()}
+        timed = {k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()}
+        _STATE["timed"] = t
+    return delta, timed
+
+
 def evaluate_task(spec: EvaluatorSpec, task: tuple) -> dict:
     """Evaluate one (id, scenario) in this process: its outputs, the counts it added (the
     first task of a process also carries its evaluator's set-up) and who computed it."""
@@ -135,17 +148,12 @@ def evaluate_task(spec: EvaluatorSpec, task: tuple) -> dict:
     t0 = time.perf_counter()
     outputs = ev.evaluate(scenario)
     seconds = time.perf_counter() - t0
-    now = ev.counts()
-    delta = _delta(now, _STATE["reported"])
-    _STATE["reported"] = now
+    delta, added = _added(ev)
     outputs = dict(outputs)
     timed = {k: float(outputs.pop(k)) for k in TIMING_OUTPUTS if k in outputs}
     result = {"id": i, "outputs": outputs, "counts": delta, "seconds": seconds,
               "worker": f"{socket.gethostname()}:{os.getpid()}"}
-    if hasattr(ev, "timings"):
-        t = {k: float(v) for k, v in ev.timings().items()}
-        timed.update({k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()})
-        _STATE["timed"] = t
+    timed.update(added)
     if timed:
         result["timings_s"] = timed
     return result
@@ -172,14 +180,7 @@ def evaluate_batch(spec: EvaluatorSpec, tasks: list) -> list:
     results = ev.evaluate_many([s for _, s in tasks])
     seconds = (time.perf_counter() - t0) / len(tasks)
     worker = f"{socket.gethostname()}:{os.getpid()}"
-    now = ev.counts()
-    delta = _delta(now, _STATE["reported"])
-    _STATE["reported"] = now
-    timed_batch = {}
-    if hasattr(ev, "timings"):
-        t = {k: float(v) for k, v in ev.timings().items()}
-        timed_batch = {k: v - _STATE["timed"].get(k, 0.0) for k, v in t.items()}
-        _STATE["timed"] = t
+    delta, timed_batch = _added(ev)
     out, first = [], True
     for (i, _), res in zip(tasks, results):
         if isinstance(res, BaseException):
