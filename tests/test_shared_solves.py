@@ -10,6 +10,7 @@ from petsc4py import PETSc
 
 from test_saved_factor import SCHUR_DOFS, matrix, vec
 from flexcontact import _cpp
+from flexcontact.errors import InputError
 from flexcontact.shared_solves import (Condense, Expand, Solve, Together, serve_alone,
                                        serve_together)
 from flexcontact.split_factor import SplitFactor
@@ -79,6 +80,29 @@ def test_runs_sharing_a_block_share_its_product(factors):
     assert stats.calls["product"] == 1 and stats.columns["product"] == 3
 
 
+def test_a_block_reads_its_array_in_place():
+    """A model's W_face or W_front is hundreds of MB: the block reads a Fortran-ordered float64
+    array where it is, makes it read-only and keeps it alive; any other array is copied once;
+    a bad shape is named."""
+    G = np.random.default_rng(5).standard_normal((40, 40))
+    F = np.asfortranarray(G @ G.T)
+    block = _cpp.DenseBlock(F)
+    view = block.matrix
+    assert np.shares_memory(view, F) and not F.flags.writeable and not view.flags.writeable
+    X = np.zeros((40, 2))
+    X[3, 0], X[:, 1] = 1.0, 0.5
+    expected = (G @ G.T) @ X
+    del F, block
+    assert np.abs(view - G @ G.T).max() == 0.0  # the view keeps block and values alive
+    C = np.ascontiguousarray(G)
+    copied = _cpp.DenseBlock(C)
+    assert not np.shares_memory(copied.matrix, C) and C.flags.writeable
+    assert np.array_equal(copied.matrix, C) and not copied.symmetric
+    assert np.abs(_cpp.DenseBlock(view).product(X) - expected).max() <= 1e-12 * np.abs(expected).max()
+    with pytest.raises(InputError, match=r"square 2-D array, got shape \(3, 4\)"):
+        _cpp.DenseBlock(np.zeros((3, 4)))
+
+
 def test_a_run_failing_between_condensation_and_expansion_leaves_the_others_right(factors):
     A, schur, plain, _ = factors
     n = A.shape[0]
@@ -143,6 +167,10 @@ def test_the_3d_block_evaluates_scenarios_side_by_side_as_one_by_one(block):
         assert middle[key] - before[key] == after[key] - middle[key], key
     assert type(ev.dam.factor).__name__ == "DistributedSchur"
     assert ev.together.calls["condense"] < ev.together.columns["condense"]
+    # One copy of each model's block: W_face and W_front are the kernel blocks' own values.
+    assert np.shares_memory(ev.dam.W_face, ev.dam.face_block.matrix)
+    log = ev.log_model(base)
+    assert np.shares_memory(log.W_front, log.front_block.matrix)
     for m, o in zip([many[0], many[2], many[3]], ones):
         # The impulse on the face is the log's loss of momentum (a conservation law, exact
         # whatever the order of the sums).

@@ -165,7 +165,47 @@ void flexcontact::bind_impact(py::module& m)
       m, "DenseBlock",
       "One body's dense flexibility block F (n x n), held once and shared by the runs that "
       "use it (FactorImpact.dense_blocks): a sweep's dam face, or a log in its own frame.")
-      .def(py::init<Matrix>(), py::arg("F"))
+      .def(py::init(
+               [](py::array_t<double, py::array::f_style | py::array::forcecast> F)
+               {
+                 if (F.ndim() != 2 || F.shape(0) != F.shape(1))
+                 {
+                   std::string shape;
+                   for (py::ssize_t i = 0; i < F.ndim(); ++i)
+                     shape += (i ? ", " : "") + std::to_string(F.shape(i));
+                   throw std::invalid_argument(
+                       "flexcontact: DenseBlock: F must be a square 2-D array, got shape ("
+                       + shape + ")");
+                 }
+                 // The block reads F where it is (a copy only if F was not Fortran-ordered
+                 // float64) and keeps it alive; F is made read-only, since the block's
+                 // symmetry and products assume values that never change.
+                 F.attr("setflags")(py::arg("write") = false);
+                 const py::ssize_t n = F.shape(0);
+                 const double* data = F.data();
+                 std::shared_ptr<const void> keeper(new py::object(std::move(F)),
+                                                    [](const py::object* o)
+                                                    {
+                                                      py::gil_scoped_acquire gil;
+                                                      delete o;
+                                                    });
+                 return std::make_shared<DenseBlock>(data, n, std::move(keeper));
+               }),
+           py::arg("F"),
+           "F: n x n; read in place (and made read-only) when it is a Fortran-ordered float64 "
+           "array, else copied once")
+      .def_property_readonly(
+          "matrix",
+          [](py::object self)
+          {
+            const auto& b = self.cast<const DenseBlock&>();
+            py::array_t<double> a({b.rows(), b.rows()},
+                                  {sizeof(double), sizeof(double) * b.rows()},
+                                  b.matrix().data(), self);
+            a.attr("setflags")(py::arg("write") = false);
+            return a;
+          },
+          "F as a read-only view (no copy)")
       .def_property_readonly("rows", &DenseBlock::rows)
       .def_property_readonly("symmetric", &DenseBlock::symmetric,
                              "True: a product with one whole column reads the lower triangle only")

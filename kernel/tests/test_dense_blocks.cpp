@@ -105,6 +105,29 @@ TEST(DenseBlock, RefusesBadInputByName)
             std::string::npos);
 }
 
+TEST(DenseBlock, ReadsItsCallersValuesInPlaceAndKeepsThemAlive)
+{
+  const Matrix F = random_spd(7, 8);
+  auto values = std::make_shared<Matrix>(F);
+  std::weak_ptr<Matrix> watch = values;
+  const double* data = values->data();
+  auto block = std::make_unique<DenseBlock>(data, 7, values);
+  values.reset();
+  EXPECT_FALSE(watch.expired()); // the block keeps them
+  EXPECT_EQ(block->matrix().data(), data);
+  EXPECT_TRUE(block->symmetric());
+  const Matrix X = Matrix::Ones(7, 2);
+  EXPECT_LE(max_abs(block->product(X) - F * X), 1e-13 * max_abs(F * X));
+  block.reset();
+  EXPECT_TRUE(watch.expired()); // and lets them go with it
+  auto nan = std::make_shared<Matrix>(Matrix::Identity(2, 2));
+  (*nan)(0, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_NE(message_of([&] { DenseBlock(nan->data(), 2, nan); }).find("not finite"),
+            std::string::npos);
+  EXPECT_NE(message_of([] { DenseBlock(nullptr, 3, nullptr); }).find("no values for a block of 3"),
+            std::string::npos);
+}
+
 TEST(SharedBlocks, AppliesTheRotatedBlockDiagonal)
 {
   const Matrix F1 = random_spd(12, 5), F2 = random_spd(9, 6);

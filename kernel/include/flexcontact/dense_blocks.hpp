@@ -22,16 +22,27 @@
 namespace flexcontact
 {
 /// @brief One dense flexibility block F (n × n), and whether it is symmetric (then a product
-/// with one whole column reads its lower triangle only: half the bytes).
+/// with one whole column reads its lower triangle only: half the bytes). The block either
+/// owns F or reads F where its caller keeps it (a model's array): a block made once per
+/// model then costs no second copy of an n² array that is hundreds of megabytes.
 class DenseBlock
 {
 public:
   /// @throws std::invalid_argument if F is not square or not finite
   explicit DenseBlock(Matrix F);
 
+  /// @brief A block read in place from n × n column-major values at `data`, which `keeper`
+  /// keeps alive and unchanged for the block's lifetime.
+  /// @throws std::invalid_argument if the values are not finite
+  DenseBlock(const double* data, Eigen::Index n, std::shared_ptr<const void> keeper);
+
+  // F_ maps own_ or the keeper's values: a copy would map the original's.
+  DenseBlock(const DenseBlock&) = delete;
+  DenseBlock& operator=(const DenseBlock&) = delete;
+
   Eigen::Index rows() const { return F_.rows(); }
   bool symmetric() const { return symmetric_; }
-  const Matrix& matrix() const { return F_; }
+  const Eigen::Map<const Matrix>& matrix() const { return F_; }
 
   /// @brief F X. A column of X with fewer than n/2 nonzero entries is formed from F's
   /// columns at those entries (contiguous, F is column-major); the other columns together,
@@ -40,7 +51,11 @@ public:
   Matrix product(const Eigen::Ref<const Matrix>& X) const;
 
 private:
-  Matrix F_;
+  void check();
+
+  Matrix own_;
+  std::shared_ptr<const void> keeper_;
+  Eigen::Map<const Matrix> F_;
   bool symmetric_ = false;
 };
 

@@ -287,9 +287,11 @@ class DamModel:
     @property
     def face_block(self):
         """W_face as the kernel's shared block (``_cpp.DenseBlock``), made once for every
-        scenario of this model."""
+        scenario of this model. The block reads W_face in place, and W_face becomes its
+        read-only view: one copy of the face's n² values, not two."""
         if getattr(self, "_face_block", None) is None:
-            self._face_block = _cpp.DenseBlock(np.asfortranarray(self.W_face))
+            self._face_block = _cpp.DenseBlock(self.W_face)
+            self.W_face = self._face_block.matrix
         return self._face_block
 
     def _strip_tags(self):

@@ -320,9 +320,12 @@ class LogModel:
     @property
     def front_block(self):
         """W_front as the kernel's shared block (``_cpp.DenseBlock``), made once: every
-        placement of this log uses it through its rotation, with no rotated copy."""
+        placement of this log uses it through its rotation, with no rotated copy. The block
+        reads W_front in place, and W_front becomes its read-only view: one copy of the
+        front's n² values, not two."""
         if getattr(self, "_front_block", None) is None:
-            self._front_block = _cpp.DenseBlock(np.asfortranarray(self.W_front))
+            self._front_block = _cpp.DenseBlock(self.W_front)
+            self.W_front = self._front_block.matrix
         return self._front_block
 
     def free_factor(self):
