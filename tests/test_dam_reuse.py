@@ -5,6 +5,7 @@ References: the monolithic run on the same scenario and time step (dam/stage2.py
 conservation of momentum (the contact impulse is the log's momentum change), the hand
 statics of the dam (statics.py), and the counts the method promises.
 """
+import dataclasses
 import math
 
 import numpy as np
@@ -16,6 +17,7 @@ from flexcontact.dam.coupled_step import holds_shared_blocks
 from flexcontact.dam.log_model import rotate_blocks, rotation
 from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
 from flexcontact.dam.statics import hand_statics
+from flexcontact.errors import InputError
 from flexcontact.dam.stage1 import solve_stage1
 from flexcontact.dam.stage2 import (log_crushing_strength_Pa, response_duration_s,
                                      solve_stage2)
@@ -342,3 +344,28 @@ def test_a_dam_factor_restored_from_files_steps_the_same_impact(evaluator, tmp_p
     for key in ("peak_force_N_per_m", "impulse_N_s_per_m", "heel_stress_impact_Pa",
                 "toe_stress_impact_Pa", "peak_tensile_stress_Pa", "log_velocity_after_m_s"):
         assert got[key] == pytest.approx(ref[key], rel=1e-10), key
+
+
+def test_log_models_beyond_keep_logs_are_let_go_with_their_counts_kept(evaluator):
+    """A sweep with a continuous density has a log per scenario: the evaluator holds
+    ``keep_logs`` log models, lets the least recently used go, and still counts every
+    factorization and back-substitution; a log asked for again is rebuilt (its factorization
+    counted) and gives the same answer (1e-12); a batch holds all its logs while it runs."""
+    ev = ScenarioEvaluator(BASE, evaluator.dt, LEVELS, COMM, keep_logs=2)
+    scenarios = [BASE.replace(wood=dataclasses.replace(BASE.wood, rho_kg_m3=rho))
+                 for rho in (560.0, 600.0, 640.0)]
+    outs = [ev.evaluate(s) for s in scenarios]
+    assert len(ev.logs.models) == 2 and ev.logs.retired["released"] == 1
+    c = ev.counts()
+    assert c["factorizations"]["log"] == 3
+    assert c["back_substitutions"]["log"] == sum(o["log_back_substitutions"] for o in outs)
+    again = ev.evaluate(scenarios[0])
+    assert ev.counts()["factorizations"]["log"] == 4
+    for k, v in outs[0].items():
+        if k != "evaluate_s" and isinstance(v, float) and np.isfinite(v):
+            assert abs(again[k] - v) <= 1e-12 * max(abs(v), 1e-300), (k, again[k], v)
+    many = ev.evaluate_many(scenarios)
+    assert all(isinstance(o, dict) for o in many)
+    assert ev.logs.keep == 2 and len(ev.logs.models) == 2
+    with pytest.raises(InputError, match="keep_logs=0: the log models to hold"):
+        ScenarioEvaluator(BASE, evaluator.dt, LEVELS, COMM, keep_logs=0)

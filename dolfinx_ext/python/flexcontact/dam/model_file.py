@@ -336,7 +336,7 @@ def _log_arrays(base, dam, logs, arrays: dict, folder: Path) -> tuple[list, int]
                                                               p + "flight")
             entry["ball"] = None if log.mesh.ball is None else list(log.mesh.ball)
         entries.append(entry)
-    return entries, sum(m.factorizations for m in cache.models.values())
+    return entries, cache.total("factorizations")
 
 
 def _section(d: dict) -> dict:

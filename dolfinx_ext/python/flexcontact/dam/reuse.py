@@ -20,6 +20,7 @@ and a round log placed by its pitch, yaw and position across the block).
 from __future__ import annotations
 
 import time
+from collections import OrderedDict
 from typing import Optional, Sequence
 
 from mpi4py import MPI
@@ -32,6 +33,12 @@ from .log_model import LogMesh, LogModel, contact_ball
 from .scenario import DamScenario
 from .stage2 import sweep_time_step_s
 from ..errors import InputError
+
+KEEP_LOGS = 8
+"""Log models a ScenarioEvaluator holds by default (LogCache ``keep``): a batch of the sweeps'
+8. At the main job's mesh a model is about half a GB (its Schur and flight factors and its
+front's flexibility); a sweep's batches are ordered by log, so the next batch's logs are
+new ones or those it already holds."""
 
 DAM_PARAMETERS = ("dim", "dam_height_m", "crest_width_m", "downstream_slope", "dam_width_m",
                   "foundation_depth_m", "foundation_upstream_m", "foundation_downstream_m",
@@ -69,14 +76,30 @@ class LogCache:
     """The log models of one dam at the time step ``dt_s`` and the scheme's ``theta``: one
     LogMesh per log geometry (its mesh, K and unit mass, every density), one LogModel per
     log (log_key), each made on first use or restored from a model file. Elements of the
-    scenario's h_log_m."""
+    scenario's h_log_m.
 
-    def __init__(self, dt_s: float, comm, theta: float):
+    ``keep``: how many log models to hold (None: all). A model holds its factors and its
+    front's n² flexibility, hundreds of MB at the main job's mesh, and a sweep whose density
+    is sampled continuously has a log per scenario: kept without bound, they exhausted the
+    memory of a 3D sweep at the main job's mesh after a few dozen scenarios. Beyond ``keep``
+    the least recently used model is let go, its counts and set-up time kept in the totals;
+    asked for again, it is rebuilt, or restored from its model file. A sweep's batches are
+    ordered by log, so a log let go is not asked for again in practice."""
+
+    def __init__(self, dt_s: float, comm, theta: float, keep: Optional[int] = None):
+        if keep is not None and not (isinstance(keep, int) and keep >= 1):
+            raise InputError(f"keep={keep!r}: the log models to hold must be an integer >= 1 "
+                             "(or None: all)")
         self.dt, self.comm, self.theta = float(dt_s), comm, float(theta)
-        self.models: dict = {}
+        self.keep = keep
+        self.models: OrderedDict = OrderedDict()
         self.meshes: dict = {}
         self.saved: dict = {}  # log_key: (scenario, loader) of a model file's large logs
+        self.adopted: dict = {}  # log_key: (scenario, LogMesh, factor) of its small ones
         self.mesh_s = 0.0
+        # what the models let go had counted
+        self.retired = {"factorizations": 0, "back_substitutions": 0, "restorations": 0,
+                        "setup_s": 0.0, "released": 0}
 
     @staticmethod
     def _mesh_key(s: DamScenario) -> tuple:
@@ -85,12 +108,17 @@ class LogCache:
 
     def get(self, s: DamScenario) -> LogModel:
         key = log_key(s)
-        if key not in self.models and key in self.saved:
-            saved_s, load = self.saved.pop(key)
+        if key in self.models:
+            self.models.move_to_end(key)
+            return self.models[key]
+        if key in self.saved:
+            saved_s, load = self.saved[key]
             mesh, factor, W_front, flight = load()
             self.meshes.setdefault(self._mesh_key(saved_s), mesh)
-            self.models[key] = self._model(saved_s, mesh, factor, W_front, flight)
-        if key not in self.models:
+            model = self._model(saved_s, mesh, factor, W_front, flight)
+        elif key in self.adopted:
+            model = self._model(*self.adopted[key])
+        else:
             mesh_key = self._mesh_key(s)
             if mesh_key not in self.meshes:
                 t0 = time.perf_counter()
@@ -98,8 +126,25 @@ class LogCache:
                                                 end=s.log_end, dim=s.dim,
                                                 ball=contact_ball(s))
                 self.mesh_s += time.perf_counter() - t0
-            self.models[key] = self._model(s, self.meshes[mesh_key])
-        return self.models[key]
+            model = self._model(s, self.meshes[mesh_key])
+        self.models[key] = model
+        self.trim()
+        return model
+
+    def trim(self, keep: Optional[int] = None) -> None:
+        """Let the least recently used models go until at most ``keep`` (default: the
+        cache's) are held; their counts stay in the totals."""
+        keep = self.keep if keep is None else keep
+        while keep is not None and len(self.models) > keep:
+            _, old = self.models.popitem(last=False)
+            for k in ("factorizations", "back_substitutions", "restorations", "setup_s"):
+                self.retired[k] += getattr(old, k, 0)
+            self.retired["released"] += 1
+
+    def total(self, what: str):
+        """A count over every model made so far (held or let go): "factorizations",
+        "back_substitutions", "restorations" or "setup_s"."""
+        return self.retired[what] + sum(getattr(m, what, 0) for m in self.models.values())
 
     def restore(self, s: DamScenario, mesh, factor) -> None:
         """Adopt the log of scenario ``s`` from a model file: its LogMesh without a mesh and
@@ -109,14 +154,17 @@ class LogCache:
         if mesh.ball != contact_ball(s):
             return
         self.meshes.setdefault(self._mesh_key(s), mesh)
+        self.adopted[log_key(s)] = (s, mesh, factor)
         self.models[log_key(s)] = self._model(s, mesh, factor)
+        self.trim()
 
     def restore_later(self, s: DamScenario, ball, load) -> None:
         """Adopt the log of scenario ``s`` that a model file holds factored by MUMPS (a large
         log): ``load()`` returns (its LogMesh without a mesh, its restored Schur factor,
-        W_front, its restored plain factor or None) and is called when the log is first
-        asked for, so that a scenario of another log reads none of its files. ``ball``:
-        the contact ball it was meshed with (the same rule as :meth:`restore`)."""
+        W_front, its restored plain factor or None) and is called when the log is asked for
+        (again, if it was let go), so that a scenario of another log reads none of its
+        files. ``ball``: the contact ball it was meshed with (the same rule as
+        :meth:`restore`)."""
         if ball != contact_ball(s):
             return
         self.saved[log_key(s)] = (s, load)
@@ -130,7 +178,7 @@ class LogCache:
 
     def setup_s(self) -> float:
         """Seconds of meshing, factorization and condensation of every log so far."""
-        return self.mesh_s + sum(m.setup_s for m in self.models.values())
+        return self.mesh_s + self.total("setup_s")
 
 
 class ScenarioEvaluator:
@@ -145,7 +193,9 @@ class ScenarioEvaluator:
     the distance from the first-contact point at which the peak principal stress is read;
     ``after_contact``: "convolve" (default: the dam is not stepped once the log has left it
     for good, the base section then comes from its response functions) or "step";
-    ``fhat``: how each scenario's kernel holds F̂ (coupled_step.FHAT; default "auto").
+    ``fhat``: how each scenario's kernel holds F̂ (coupled_step.FHAT; default "auto");
+    ``keep_logs``: how many log models to hold (:class:`LogCache`; default
+    :data:`KEEP_LOGS`, and never fewer than the scenarios of one :meth:`evaluate_many`).
     """
 
     def __init__(self, base: DamScenario, dt_s: Optional[float] = None,
@@ -154,7 +204,7 @@ class ScenarioEvaluator:
                  strip_m: Optional[tuple[float, float]] = None, offset_m: float = 1.0,
                  patch_y_m: Optional[tuple[float, float]] = None,
                  after_contact: str = "convolve", dam: Optional[DamModel] = None,
-                 fhat: str = "auto"):
+                 fhat: str = "auto", keep_logs: Optional[int] = None):
         if base.westergaard:
             raise InputError("westergaard=True: the reservoir's added mass depends on the water "
                              "level, so one factored dam cannot serve a sweep over it; use the "
@@ -165,6 +215,11 @@ class ScenarioEvaluator:
             raise InputError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
         if fhat not in FHAT:
             raise InputError(f"fhat={fhat!r}: one of {FHAT}")
+        keep_logs = KEEP_LOGS if keep_logs is None else keep_logs
+        if not (isinstance(keep_logs, int) and not isinstance(keep_logs, bool)
+                and keep_logs >= 1):
+            raise InputError(f"keep_logs={keep_logs!r}: the log models to hold must be an "
+                             "integer >= 1")
         self.base, self.offset_m, self.after_contact = base, float(offset_m), after_contact
         self.fhat = fhat
         self.dt = (dam.dt if dam is not None else
@@ -176,7 +231,7 @@ class ScenarioEvaluator:
                                                         strip_m=strip_m,
                                                         patch_y_m=patch_y_m)
         self.dam.static_state(base.water_level_m)
-        self.logs = LogCache(self.dt, self.dam.comm, self.dam.theta)
+        self.logs = LogCache(self.dt, self.dam.comm, self.dam.theta, keep=keep_logs)
         self._steps_s = 0.0
         self._split: dict = {}  # run_impact's coupled steps, log-only steps, convolution
         self.together = Together()  # evaluate_many's shared calls
@@ -239,6 +294,15 @@ class ScenarioEvaluator:
         condensation only (a split factor: the 2D section, a small log) cannot be shared:
         the scenarios are then evaluated one after the other."""
         scenarios = list(scenarios)
+        # The batch's own logs stay held until it is done.
+        keep, self.logs.keep = self.logs.keep, max(self.logs.keep or 0, len(scenarios))
+        try:
+            return self._evaluate_many(scenarios)
+        finally:
+            self.logs.keep = keep
+            self.logs.trim()
+
+    def _evaluate_many(self, scenarios: list) -> list:
         results: list = [None] * len(scenarios)
         runs, where = [], []
         for k, s in enumerate(scenarios):
@@ -286,12 +350,11 @@ class ScenarioEvaluator:
 
     def counts(self) -> dict:
         """{"factorizations": {"dam_stage1", "dam_stage2", "log"}, "back_substitutions":
-        {same keys}}; "log" sums over the cached log models."""
+        {same keys}}; "log" sums over every log model made, held or let go."""
         c = self.dam.counts()
-        logs = list(self.logs.models.values())
-        c["factorizations"]["log"] = sum(m.factorizations for m in logs)
-        c["back_substitutions"]["log"] = sum(m.back_substitutions for m in logs)
-        restored = sum(getattr(m, "restorations", 0) for m in logs)
+        c["factorizations"]["log"] = self.logs.total("factorizations")
+        c["back_substitutions"]["log"] = self.logs.total("back_substitutions")
+        restored = self.logs.total("restorations")
         if restored:
             c.setdefault("restorations", {})["log"] = restored
         return c
