@@ -81,7 +81,7 @@ class LogCache:
     ``keep``: how many log models to hold (None: all). A model holds its factors and its
     front's n² flexibility, hundreds of MB at the main job's mesh, and a sweep whose density
     is sampled continuously has a log per scenario: kept without bound, they exhausted the
-    memory of a 3D sweep at the main job's mesh after a few dozen scenarios. Beyond ``keep``
+    memory of a 3D sweep at the main job's mesh after 15 scenarios. Beyond ``keep``
     the least recently used model is let go, its counts and set-up time kept in the totals;
     asked for again, it is rebuilt, or restored from its model file. A sweep's batches are
     ordered by log, so a log let go is not asked for again in practice."""
