@@ -87,11 +87,8 @@ class LogCache:
     ordered by log, so a log let go is not asked for again in practice."""
 
     def __init__(self, dt_s: float, comm, theta: float, keep: Optional[int] = None):
-        if keep is not None and not (isinstance(keep, int) and keep >= 1):
-            raise InputError(f"keep={keep!r}: the log models to hold must be an integer >= 1 "
-                             "(or None: all)")
         self.dt, self.comm, self.theta = float(dt_s), comm, float(theta)
-        self.keep = keep
+        self.keep = self.checked_keep(keep)
         self.models: OrderedDict = OrderedDict()
         self.meshes: dict = {}
         self.saved: dict = {}  # log_key: (scenario, loader) of a model file's large logs
@@ -100,6 +97,13 @@ class LogCache:
         # what the models let go had counted
         self.retired = {"factorizations": 0, "back_substitutions": 0, "restorations": 0,
                         "setup_s": 0.0, "released": 0}
+
+    @staticmethod
+    def checked_keep(keep: Optional[int], name: str = "keep") -> Optional[int]:
+        """``keep`` if it is None (all) or an integer >= 1; else InputError naming ``name``."""
+        if keep is None or (isinstance(keep, int) and not isinstance(keep, bool) and keep >= 1):
+            return keep
+        raise InputError(f"{name}={keep!r}: the log models to hold must be an integer >= 1")
 
     @staticmethod
     def _mesh_key(s: DamScenario) -> tuple:
@@ -215,11 +219,8 @@ class ScenarioEvaluator:
             raise InputError(f"after_contact={after_contact!r}: one of {AFTER_CONTACT}")
         if fhat not in FHAT:
             raise InputError(f"fhat={fhat!r}: one of {FHAT}")
-        keep_logs = KEEP_LOGS if keep_logs is None else keep_logs
-        if not (isinstance(keep_logs, int) and not isinstance(keep_logs, bool)
-                and keep_logs >= 1):
-            raise InputError(f"keep_logs={keep_logs!r}: the log models to hold must be an "
-                             "integer >= 1")
+        keep_logs = LogCache.checked_keep(KEEP_LOGS if keep_logs is None else keep_logs,
+                                          "keep_logs")
         self.base, self.offset_m, self.after_contact = base, float(offset_m), after_contact
         self.fhat = fhat
         self.dt = (dam.dt if dam is not None else
@@ -295,7 +296,9 @@ class ScenarioEvaluator:
         the scenarios are then evaluated one after the other."""
         scenarios = list(scenarios)
         # The batch's own logs stay held until it is done.
-        keep, self.logs.keep = self.logs.keep, max(self.logs.keep or 0, len(scenarios))
+        keep = self.logs.keep
+        if keep is not None:
+            self.logs.keep = max(keep, len(scenarios))
         try:
             return self._evaluate_many(scenarios)
         finally:
