@@ -59,7 +59,7 @@ ASK = ["--log-speed-m-s", "3", "--log-pitch-deg", "10", "--log-length-m", "12",
 if args.dim == 3:
     ASK += ["--log-yaw-deg", "10", "--log-across-m", "6.5"]
 if args.main_job:
-    ASK = ["--log-speed-m-s", "2"]  # DamScenario's default log, as demos/dam_debris.py
+    ASK = ["--log-speed-m-s", "2"]  # the model's own log (its rounded end), the main job's
 with tempfile.TemporaryDirectory() as tmp:
     model = Path(tmp) / "model"
     t0 = time.perf_counter()

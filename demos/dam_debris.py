@@ -9,10 +9,13 @@
 #
 # By default the dam is a 3D block between contraction joints (15 m wide, `--dam-width`) on
 # its foundation, and the log a round one, pitched 10° (`--log-pitch`, `--log-yaw`), whose
-# front end crushes at the wood's crushing strength (docs/crushing.md); the log's end is
+# front end is rounded, not sawn (a spherical cap of radius D: drift logs arrive with root
+# masses and broken tops, not saw cuts; docs/dam.md, "Scenario"), and crushes at the wood's
+# crushing strength (docs/crushing.md); the log's end is
 # refined about the first-contact point so that the crushed patch at the peak force spans at
-# least four elements (CRUSHED_PATCH_MESH: in 3D 12.5 mm within 0.35 m of it and 5 cm deep
-# behind the end, `--contact-size`, `--contact-zone`, `--contact-layer`), and the rest has
+# least four elements (`scenario.crushed_patch_mesh`: in 3D 12.5 mm within 0.2 m of it for
+# the cap, 0.35 m for a flat end's corner, and 5 cm deep behind the end, `--contact-size`,
+# `--contact-zone`, `--contact-layer`), and the rest has
 # elements of 0.2 m on the log and
 # near it, 3 m far from it (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study
 # below says why). `--elastic-end` keeps the end elastic (the upper bound
@@ -68,8 +71,9 @@ parser.add_argument("--theta", type=float, default=0.55,
                          "front chatter: docs/dam.md, \"The time scheme\")")
 parser.add_argument("--gap", type=float, default=0.02, help="log to face, m")
 parser.add_argument("--mu", type=float, default=0.5, help="friction coefficient (stage 2)")
-parser.add_argument("--log-end", default="flat", choices=("flat", "chamfered", "rounded"),
-                    help="the log's front end: sawn flat, chamfered, or a spherical cap")
+parser.add_argument("--log-end", default="rounded", choices=("flat", "chamfered", "rounded"),
+                    help="the log's front end: a spherical cap (default), sawn flat, or "
+                         "chamfered")
 parser.add_argument("--end-chamfer", type=float, default=None,
                     help="chamfer c of a chamfered end, m (0 < c < D/2; default D/8)")
 parser.add_argument("--end-radius", type=float, default=None,
@@ -82,7 +86,9 @@ parser.add_argument("--contact-size", type=float, default=None,
                          "(default: CRUSHED_PATCH_MESH of the dimension; with --elastic-end: "
                          "the impact zone's)")
 parser.add_argument("--contact-zone", type=float, default=None,
-                    help="radius (m) of the refined ball about the first-contact point")
+                    help="radius (m) of the refined ball about the first-contact point "
+                         "(default: crushed_patch_mesh of the dimension and end: in 3D 0.2 m "
+                         "for a rounded end, 0.35 m otherwise)")
 parser.add_argument("--contact-layer", type=float, default=None,
                     help="depth (m) behind the log's end within which the ball keeps "
                          "--contact-size; deeper, elements grow (default: CRUSHED_PATCH_MESH "
@@ -130,9 +136,9 @@ t_start = time.perf_counter()
 # meshed. The log's elevation is not an input: it floats at its draft.
 
 # %%
-from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, MAIN_JOB_MESH
+from flexcontact.dam.scenario import MAIN_JOB_MESH, crushed_patch_mesh
 crushes = not args.elastic_end
-size, zone, layer = CRUSHED_PATCH_MESH[args.dim] if crushes else (None, 0.1, None)
+size, zone, layer = crushed_patch_mesh(args.dim, args.log_end) if crushes else (None, 0.1, None)
 far_size, impact_size = MAIN_JOB_MESH[args.dim]
 scenario = DamScenario(
     dim=args.dim, dam_width_m=args.dam_width, refine=args.refine,
@@ -228,7 +234,8 @@ if comm.rank == 0:
 # the dam and foundation start from stage 1's displacement under the same constant loads,
 # so they are at rest until the log arrives. The log's density is raised by the added-mass
 # coefficient, ρ_wood (1 + C_a), and its weight and buoyancy cancel. Contact: the log's
-# front end (its lower front corner touches first) against the face, node–surface with
+# front end (the point of its cap nearest the face touches first; of a flat end, the lower
+# front corner) against the face, node–surface with
 # Coulomb friction μ; the pairs are made once at the initial positions (the log slides
 # along the face by much less than an element). Time integration:
 # Moreau–Jean on the condensed system, `dt` = 2L/c of the log / 40 by default, with
@@ -239,11 +246,11 @@ if comm.rank == 0:
 # contact duration and the impulse, checked against the log's change of momentum
 # m_eff Δv from the velocities of its nodes before and after (no other force acts on the
 # log, so they agree to round-off); the largest principal stress in the dam at
-# `--impact-offset` from the first-contact point (the corner's own stress grows with
+# `--impact-offset` from the first-contact point (the contact's own stress grows with
 # refinement), read from the recovered (nodal-average) stress, with Boussinesq's
 # half-space value beside it in 3D, where the face's tension lies in a layer thinner
 # than the elements; and the peak contact pressure (mean over a step and a node's tributary
-# length: mesh-dependent at a corner contact) against the wood's crushing strength.
+# length: mesh-dependent where a corner touches) against the wood's crushing strength.
 #
 # What engineers use: the base section's force and moment at every step, from the dam's
 # displacement (the same nodal residual as in stage 1), and from them the linearised heel

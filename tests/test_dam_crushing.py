@@ -209,6 +209,17 @@ def test_bad_crushing_inputs_are_named_before_meshing(change, words):
         DamScenario(**change)
 
 
+def test_the_rounded_end_takes_a_smaller_ball_in_3d_only():
+    """The main job's rounded end crushes a disc about the cap's first-contact point,
+    0.24 m across (docs/dam.md, "The main job"): a 0.2 m ball holds it; the flat end's
+    corner keeps the 0.35 m ball, and the 2D section its 0.1 m one for every end."""
+    from flexcontact.dam.scenario import CRUSHED_PATCH_MESH, crushed_patch_mesh
+    assert crushed_patch_mesh(3, "rounded") == (0.0125, 0.2, 0.05)
+    assert crushed_patch_mesh(3, "flat") == crushed_patch_mesh(3, "chamfered") \
+        == CRUSHED_PATCH_MESH[3]
+    assert crushed_patch_mesh(2, "rounded") == crushed_patch_mesh(2) == CRUSHED_PATCH_MESH[2]
+
+
 # ---- the crushed patch's refinement on the factored dam's log -----------------------------
 
 @pytest.mark.parametrize("dim, end, angles", [

@@ -103,9 +103,10 @@ def _limits(st2: dict | None, westergaard: bool = False, dim: int = 2,
              + "; the pressure ratio is at most 1 by the crushing law. "
              + _chatter(theta)
              if crushes else
-             "A pressure ratio above 1 means the wood would crush locally under the corner "
-             "that touches first (a mesh-dependent peak: the contact pressure is the mean "
-             "over a node's tributary length), which would lower the peak force. ")
+             "A pressure ratio above 1 means the wood would crush locally where the end "
+             "touches first (a mesh-dependent peak: the contact pressure is the mean over a "
+             "node's tributary measure, singular under a flat end's corner), which would "
+             "lower the peak force. ")
             + "A stress ratio above 1 would mean cracking, which the model cannot follow.",
             ""]
     return out
@@ -261,8 +262,9 @@ def _mesh_study(rows: list) -> list:
             out.append(f"| {head} | {vals} | {ext} | {p} | {gci} |")
         out += ["", "Δσ is the impact's change of the linearised stress (during − before): "
                 "the static part is exact on any mesh and would dilute the error. The "
-                "contact pressure under the log's corner is singular and grows with "
-                "refinement, so it is no design value.", ""]
+                "peak contact pressure is no design value: it is capped at the crushing "
+                "strength where the end crushes, and otherwise grows with refinement "
+                "under a flat end's corner.", ""]
     return out
 
 

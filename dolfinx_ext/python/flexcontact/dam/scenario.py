@@ -67,14 +67,36 @@ _DEFAULT_MESH = {2: (3.0, 0.2), 3: (6.0, 0.4)}  # (far, impact) element sizes in
 CRUSHED_PATCH_MESH = {2: (0.00625, 0.1, None), 3: (0.0125, 0.35, 0.05)}
 """(mesh_size_contact_m, contact_zone_m, contact_layer_m) by dimension that resolve the
 crushed patch of the default log (10 m × Ø0.8 m, 10° pitch, 2 m/s, flat end, σ_c =
-26.1 MPa) at the peak force by at least four elements: the main job's. Measured at θ = 0.55
+26.1 MPa) at the peak force by at least four elements (the main job's rounded end:
+:func:`crushed_patch_mesh`). Measured at θ = 0.55
 (docs/dam.md, "The time scheme"): in 2D the patch is about 5 cm along the end (11 crushing
 nodes at 6.25 mm); the filtered peak force 1.79, 1.62, 1.76, 1.68, 1.63 MN/m at 50, 25,
 12.5, 6.25, 3.1 mm (order 0.9 over the last three, extrapolated 1.58). In 3D the patch is a
 segment of the end, 279 pairs at their cap at 12.5 mm within the 0.35 m ball. In 3D the
-ball refines the log only (meshes/dam.py), and only 5 cm deep behind its end: the main
-job's mesh has 28,071 DOFs; with the whole ball refined it had more than twice as many,
+ball refines the log only (meshes/dam.py), and only 5 cm deep behind its end: the flat
+end at the main job's sizes has 28,071 DOFs; with the whole ball refined it had more than
+twice as many,
 and its answers differed by 0.2 % or less (docs/dam.md, "The mesh study")."""
+
+
+ROUNDED_PATCH_ZONE_M = 0.2
+"""contact_zone_m of the rounded end in 3D. Its crushed patch is a disc about the cap's
+first-contact point, of radius √(2ρδ) for a crush depth δ: 0.12 m for the main job's log
+(ρ = D, δ = 8.9 mm), 336 pairs at their cap at 12.5 mm. A 0.2 m ball holds it with six
+elements to spare, and puts 1,259 nodes on the end where the flat end's 0.35 m ball puts
+2,913 on the cap; against the 0.35 m ball the main job's filtered peak force moved by
++1.1 %, Δσ_heel by +0.8 % and the impulse by +0.1 %, inside their discretisation error
+(docs/dam.md, "The mesh study")."""
+
+
+def crushed_patch_mesh(dim: int, end_shape: str = "flat") -> tuple:
+    """(mesh_size_contact_m, contact_zone_m, contact_layer_m) that resolve the default log's
+    crushed patch with the end ``end_shape``: :data:`CRUSHED_PATCH_MESH`, with the smaller
+    ball :data:`ROUNDED_PATCH_ZONE_M` for a rounded end in 3D."""
+    size, zone, layer = CRUSHED_PATCH_MESH[dim]
+    if dim == 3 and end_shape == "rounded":
+        zone = ROUNDED_PATCH_ZONE_M
+    return size, zone, layer
 
 
 MAIN_JOB_MESH = {2: (3.0, 0.2), 3: (3.0, 0.2)}
