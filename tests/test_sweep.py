@@ -648,6 +648,7 @@ def test_end_shape_is_sampled_uniformly_and_reported_per_name(tmp_path):
     assert w["value"] == force.max() and w["inputs"] == points[int(np.argmax(force))]
     report = (tmp_path / "out" / "report.md").read_text()
     assert "## By log end shape (`log_end_shape`)" in report
+    assert "The log's end, its shape swept, " in report  # not the base scenario's shape
     assert (tmp_path / "out" / "envelope_peak_force_N_per_m.png").exists()
     rows = (tmp_path / "out" / "results.csv").read_text()
     assert "'rounded'" in rows

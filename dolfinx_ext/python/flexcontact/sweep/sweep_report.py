@@ -132,7 +132,7 @@ def markdown(summary: dict, inputs: list) -> str:
          + (f" (dam {three_figures(base['dam_height_m'])} m high"
             f", concrete tensile strength "
             f"{three_figures(base['concrete_tensile_strength_Pa'], 1e-6)} MPa)"
-            if "dam_height_m" in base else "") + ". " + _end(base) + _mesh(s), ""]
+            if "dam_height_m" in base else "") + ". " + _end(base, inputs) + _mesh(s), ""]
     if s.get("input_ranges"):
         L += ["## Inputs", "", "The range each input took over the sweep.", "",
               *_inputs_table(dim, s["input_ranges"]), ""]
@@ -222,15 +222,17 @@ def markdown(summary: dict, inputs: list) -> str:
     return "\n".join(L)
 
 
-def _end(base: dict) -> str:
-    """What the log's end does, in one sentence (the force depends on it first)."""
+def _end(base: dict, inputs: list = ()) -> str:
+    """What the log's end does, in one sentence (the force depends on it first); its shape
+    is the base scenario's unless the sweep samples it."""
     if "log_end_crushes" not in base:
         return ""
-    shape = base.get("log_end_shape", "flat")
+    end = ("end, its shape swept," if "log_end_shape" in inputs
+           else f"{base.get('log_end_shape', 'flat')} end")
     if base["log_end_crushes"]:
-        return (f"The log's {shape} end crushes at "
+        return (f"The log's {end} crushes at "
                 f"{three_figures(base['wood_crushing_strength_Pa'], 1e-6)} MPa.")
-    return (f"The log's {shape} end does not crush: the forces are the elastic bound of an "
+    return (f"The log's {end} does not crush: the forces are the elastic bound of an "
             "intact log, above what a crushing end transmits.")
 
 
