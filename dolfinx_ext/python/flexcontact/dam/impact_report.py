@@ -44,7 +44,9 @@ def _end(s: dict) -> str:
         return f"front end chamfered {c:g} m at 45°"
     if shape == "rounded":
         rho = s.get("log_end_radius_m") or D
-        return f"front end a spherical cap of radius {rho:g} m"
+        return (f"front end a spherical cap of radius {rho:g} m (a drift log's worn end: its "
+                "ends are a root mass and a broken top, not a saw cut; the radius is not "
+                "measured, docs/dam.md)")
     return "flat (sawn) front end"
 
 
