@@ -15,10 +15,9 @@
 # refined about the first-contact point so that the crushed patch at the peak force spans at
 # least four elements (`scenario.crushed_patch_mesh`: in 3D 12.5 mm within 0.2 m of it for
 # the cap, 0.35 m for a flat end's corner, and 5 cm deep behind the end, `--contact-size`,
-# `--contact-zone`, `--contact-layer`), and the rest has
-# elements of 0.2 m on the log and
-# near it, 3 m far from it (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study
-# below says why). `--elastic-end` keeps the end elastic (the upper bound
+# `--contact-zone`, `--contact-layer`), and the rest has elements of 0.1 m on the log's
+# shaft (MAIN_JOB_LOG_MESH_M, `--log-size`), 0.2 m within 1 m of the log and 3 m far from it
+# (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study below says why). `--elastic-end` keeps the end elastic (the upper bound
 # of the force); `--log-end` shapes it (flat, chamfered, rounded). `--dim 2` runs the
 # plane-strain section instead: per metre of dam, a raft of logs abreast along the whole
 # crest, not one log.
@@ -96,8 +95,12 @@ parser.add_argument("--contact-layer", type=float, default=None,
 parser.add_argument("--far-size", type=float, default=None,
                     help="element size far from the log, m (default: MAIN_JOB_MESH, 3 m)")
 parser.add_argument("--impact-size", type=float, default=None,
-                    help="element size on the log and within 1 m of it, m (default: "
+                    help="element size within 1 m of the log, and on it in 2D, m (default: "
                          "MAIN_JOB_MESH, 0.2 m)")
+parser.add_argument("--log-size", type=float, default=None,
+                    help="element size on the log's shaft, m (default: MAIN_JOB_LOG_MESH_M, "
+                         "in 3D 0.1 m: four elements across the log are too stiff in "
+                         "bending; in 2D the impact size)")
 parser.add_argument("--offset", type=float, default=1.0,
                     help="distance from the heel at which the peak stress is reported, m")
 parser.add_argument("--stage1-only", action="store_true", help="skip the impact (stage 2)")
@@ -136,7 +139,7 @@ t_start = time.perf_counter()
 # meshed. The log's elevation is not an input: it floats at its draft.
 
 # %%
-from flexcontact.dam.scenario import MAIN_JOB_MESH, crushed_patch_mesh
+from flexcontact.dam.scenario import MAIN_JOB_LOG_MESH_M, MAIN_JOB_MESH, crushed_patch_mesh
 crushes = not args.elastic_end
 size, zone, layer = crushed_patch_mesh(args.dim, args.log_end) if crushes else (None, 0.1, None)
 far_size, impact_size = MAIN_JOB_MESH[args.dim]
@@ -153,7 +156,8 @@ scenario = DamScenario(
     mesh_size_contact_m=args.contact_size or size, contact_zone_m=args.contact_zone or zone,
     contact_layer_m=args.contact_layer or layer,
     mesh_size_far_m=args.far_size or far_size,
-    mesh_size_impact_m=args.impact_size or impact_size)
+    mesh_size_impact_m=args.impact_size or impact_size,
+    mesh_size_log_m=args.log_size or MAIN_JOB_LOG_MESH_M[args.dim])
 folder = fc.results_folder("dam_debris")
 
 # %% [markdown]
@@ -354,7 +358,8 @@ if not args.stage1_only and not args.no_paraview:
 # The crushed patch's contact mesh is refined with the rest; in 3D its contact zone then
 # outgrows the dense operators, and the finer meshes hold it through the factor of the
 # iteration matrix (`--contact-operator factor`, the same answer to rounding). In 3D the
-# study takes about 7 minutes and 3.7 GB here; `--mesh-study-contact kept` keeps the patch
+# study took 25 minutes and 4.8 GB here, beside other jobs (its finest mesh has 229,000
+# DOFs, the log's shaft at 5 cm); `--mesh-study-contact kept` keeps the patch
 # at its size and refines the rest, leaving out the patch's error.
 
 # %%
