@@ -220,6 +220,24 @@ def test_the_rounded_end_takes_a_smaller_ball_in_3d_only():
     assert crushed_patch_mesh(2, "rounded") == crushed_patch_mesh(2) == CRUSHED_PATCH_MESH[2]
 
 
+def test_the_main_jobs_dam_model_config_is_the_main_jobs_mesh_and_log():
+    """examples/dam_model_main_job.toml writes the main job's sizes out in TOML: they must stay
+    the demo's (MAIN_JOB_MESH, MAIN_JOB_LOG_MESH_M, crushed_patch_mesh of its rounded end)."""
+    from pathlib import Path
+    from flexcontact import sweep
+    from flexcontact.dam.scenario import MAIN_JOB_LOG_MESH_M, MAIN_JOB_MESH, crushed_patch_mesh
+    from flexcontact.sweep.scenarios import build_scenarios
+    cfg = sweep.config.load(Path(__file__).resolve().parents[1] / "examples"
+                            / "dam_model_main_job.toml")
+    base, _, _ = build_scenarios(cfg)
+    h_c, zone, layer = crushed_patch_mesh(3, "rounded")
+    assert (base.dim, base.log_end_shape, base.log_end_crushes) == (3, "rounded", True)
+    assert (base.mesh_size_far_m, base.mesh_size_impact_m) == MAIN_JOB_MESH[3]
+    assert base.mesh_size_log_m == MAIN_JOB_LOG_MESH_M[3]
+    assert (base.mesh_size_contact_m, base.contact_zone_m, base.contact_layer_m) \
+        == (h_c, zone, layer)
+
+
 # ---- the crushed patch's refinement on the factored dam's log -----------------------------
 
 @pytest.mark.parametrize("dim, end, angles", [
