@@ -17,8 +17,9 @@
 # the cap, 0.35 m for a flat end's corner, and 5 cm deep behind the end, `--contact-size`,
 # `--contact-zone`, `--contact-layer`), and the rest has elements of 0.1 m on the log's
 # shaft (MAIN_JOB_LOG_MESH_M, `--log-size`), 0.2 m within 1 m of the log and 3 m far from it
-# (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study below says why). `--elastic-end` keeps the end elastic (the upper bound
-# of the force); `--log-end` shapes it (flat, chamfered, rounded). `--dim 2` runs the
+# (MAIN_JOB_MESH, `--impact-size`, `--far-size`: the mesh study below says why).
+# `--elastic-end` keeps the end elastic (the upper bound of the force); `--log-end` shapes
+# it (flat, chamfered, rounded). `--dim 2` runs the
 # plane-strain section instead: per metre of dam, a raft of logs abreast along the whole
 # crest, not one log.
 #
