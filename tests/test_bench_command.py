@@ -66,4 +66,11 @@ def test_bench_mpi_section_tiny(tmp_path):
         assert row["max_rel_diff"][key] is not None and row["max_rel_diff"][key] < 1e-10, key
     for p in row["phases"]:
         assert math.isclose(p["speedup"], p["serial_s"] / p["np2_s"], rel_tol=1e-12)
-    assert "Serial against `mpirun -n 2`" in (tmp_path / "RESULTS.md").read_text()
+    # the run (set-up + 10 increments) from the same phase times
+    t = {p["key"]: p for p in row["phases"]}
+    one = t["setup_s"]["serial_s"] + 10 * t["increment_s"]["serial_s"]
+    two = t["setup_s"]["np2_s"] + 10 * t["increment_s"]["np2_s"]
+    assert math.isclose(run.report.run_speedup(row), one / two, rel_tol=1e-12)
+    text = (tmp_path / "RESULTS.md").read_text()
+    assert "Serial against `mpirun -n 2`" in text
+    assert "run (set-up + 10 increments) speed-up" in text
