@@ -10,20 +10,22 @@ functions, more than the runs use, the face compliance of the re-contact bound: 
 file keeps), then three
 crushing scenarios at one time step:
 
-* A: the main job's own (10 m × Ø0.8 m log, 10° pitch, 2 m/s, flat end);
+* A: the main job's own (10 m × Ø0.8 m log, 10° pitch, 2 m/s);
 * B: a 12 m log at 3 m/s, 5° pitch, 10° yaw, 6.5 m across the block;
 * C: an 8 m × Ø0.5 m log at 1.5 m/s, 12° pitch, −8° yaw, 9 m across.
 
-Each scenario's log is meshed and factored on first use (its set-up is timed apart from its
-steps, as a sweep meshes each log geometry once). The errors are against the first setting
-(the main job's mesh: 3 m far, 0.2 m on the impact zone, the log's end 12.5 mm within
-0.35 m of the first contact and 5 cm deep), scenario by scenario. The projection of 1,000
+All three have the end ``--end`` (default the main job's rounded one; the crushed patch's
+ball is then ``crushed_patch_mesh``'s for that shape). Each scenario's log is meshed and
+factored on first use (its set-up is timed apart from its steps, as a sweep meshes each log
+geometry once). The errors are against the first setting (the main job's mesh: 3 m far,
+0.2 m on the impact zone, the log at 0.1 m and its end 12.5 mm within the ball of the first
+contact and 5 cm deep), scenario by scenario. The projection of 1,000
 scenarios on 2 workers is the set-up plus 500 times the mean scenario's steps; it
 leaves out the logs' set-up, paid once per log geometry, and a whole sweep costs about twice
 that a scenario (a shorter time step, faster logs, two workers sharing the memory bus:
 docs/dam.md, "The 3D sweep's trade-off").
 
-    /usr/bin/python3 bench/sweep_tradeoff_3d.py [--settings 3,0.2,0.0125 6,0.4,0.025,0.2 ...]
+    /usr/bin/python3 bench/sweep_tradeoff_3d.py [--end flat] [--settings 3,0.2,0.0125,0.1 ...]
 
 Writes bench/sweep_tradeoff_3d.json.
 """
@@ -36,12 +38,16 @@ from pathlib import Path
 
 from flexcontact.dam import DamScenario
 from flexcontact.dam.reuse import ScenarioEvaluator, sweep_time_step_s
+from flexcontact.dam.scenario import MAIN_JOB_LOG_MESH_M, MAIN_JOB_MESH, crushed_patch_mesh
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from machine import machine  # noqa: E402
 
-DEFAULT_SETTINGS = ["3,0.2,0.0125", "3,0.2,0.025", "3,0.3,0.025,0.2", "6,0.4,0.025,0.2",
-                    "6,0.4,0.05,0.2", "6,0.4,0.025"]
+MAIN_JOB = "{},{},{},{}".format(*MAIN_JOB_MESH[3], crushed_patch_mesh(3)[0],
+                                 MAIN_JOB_LOG_MESH_M[3])
+DEFAULT_SETTINGS = [MAIN_JOB, "3,0.2,0.025,0.1", "3,0.3,0.025,0.1", "6,0.4,0.025,0.1",
+                    "6,0.4,0.05,0.1", "6,0.4,0.05,0.15", "3,0.2,0.025,0.2", "3,0.3,0.025,0.2",
+                    "6,0.4,0.025,0.2", "6,0.4,0.05,0.2", "6,0.4,0.025"]
 OUTPUTS = ("peak_force_filtered_N_per_m", "impulse_N_s_per_m", "delta_heel_stress_Pa",
            "peak_tensile_stress_Pa")
 
@@ -49,10 +55,16 @@ ap = argparse.ArgumentParser(description=__doc__,
                              formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--settings", nargs="+", default=DEFAULT_SETTINGS,
                 help="far,impact,contact[,log] element sizes (m); the first is the reference")
-ap.add_argument("--zone-m", type=float, default=0.35, help="the crushed patch's ball radius")
-ap.add_argument("--layer-m", type=float, default=0.05, help="its depth behind the end")
+ap.add_argument("--end", choices=("rounded", "flat"), default="rounded",
+                help="the logs' front end (the main job's: rounded)")
+ap.add_argument("--zone-m", type=float, default=None,
+                help="the crushed patch's ball radius (default: crushed_patch_mesh's for --end)")
+ap.add_argument("--layer-m", type=float, default=None, help="its depth behind the end")
 ap.add_argument("--out", default=str(Path(__file__).with_name("sweep_tradeoff_3d.json")))
 args = ap.parse_args()
+_, _zone, _layer = crushed_patch_mesh(3, args.end)
+args.zone_m = _zone if args.zone_m is None else args.zone_m
+args.layer_m = _layer if args.layer_m is None else args.layer_m
 
 
 def parse(setting: str) -> tuple:
@@ -66,7 +78,8 @@ def scenarios(far: float, impact: float, contact: float, log) -> list[DamScenari
     base = DamScenario(dim=3, mesh_size_far_m=far, mesh_size_impact_m=impact,
                        mesh_size_log_m=log,
                        mesh_size_contact_m=contact, contact_zone_m=args.zone_m,
-                       contact_layer_m=args.layer_m, log_end_crushes=True)
+                       contact_layer_m=args.layer_m, log_end_crushes=True,
+                       log_end_shape=args.end)
     return [base,
             base.replace(log_length_m=12.0, log_speed_m_s=3.0, log_pitch_deg=5.0,
                          log_yaw_deg=10.0, log_across_m=6.5),
@@ -125,5 +138,5 @@ for r in results:
           "error " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in r["largest_error"].items()))
 Path(args.out).write_text(json.dumps(
     {"what": "3D crushing scenarios on the factored dam block at several meshes",
-     "dt_s": dt, "zone_m": args.zone_m, "layer_m": args.layer_m, "settings": results,
+     "dt_s": dt, "end": args.end, "zone_m": args.zone_m, "layer_m": args.layer_m, "settings": results,
      "load_average_1min": os.getloadavg()[0], "machine": machine()}, indent=1))
