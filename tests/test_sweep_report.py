@@ -119,3 +119,24 @@ def test_a_swept_tensile_strength_is_compared_per_scenario(tmp_path):
     assert c["above_tensile_strength"]["p"] == sum(above) / len(points)
     assert c["tensile_strength_Pa"] is None
     assert "f_t is swept" in (tmp_path / "out" / "report.md").read_text()
+
+
+def _crushing_summary(forces, dim=3, crushes=True):
+    return {"dim": dim, "base": {"log_end_crushes": crushes, "wood_crushing_strength_Pa": 26.1e6},
+            "mesh": {"h_far_m": 6.0, "h_impact_m": 0.4, "h_log_m": 0.2, "h_contact_m": 0.05,
+                     "contact_zone_m": 0.35, "contact_layer_m": 0.05},
+            "exceedance": {"peak_force_filtered_N_per_m": {"x": sorted(forces)}}}
+
+
+def test_a_crushing_ends_force_steps_are_stated_where_scenarios_tie():
+    """Three of five scenarios with one peak force to the last digit: the report says why
+    (σ_c·h² = 26.1 MPa × (50 mm)² = 0.06525 MN) and counts the ties (2 beyond the first)."""
+    from flexcontact.sweep.sweep_report import _mesh
+    tied = _mesh(_crushing_summary([3.27e5, 3.27e5, 3.27e5, 4.1e5, 6.0e5]))
+    assert ("where only a few of them crush, the force comes in steps of about σ_c·h² = "
+            "0.0653 MN, and 2 of the 5 scenarios share their filtered peak force") in tied
+    assert "end's 50.0 mm elements" in tied
+    for quiet in (_crushing_summary([3.27e5, 4.1e5, 6.0e5]),           # no tie
+                  _crushing_summary([3.27e5, 3.27e5], crushes=False),  # elastic end
+                  _crushing_summary([3.27e5, 3.27e5], dim=2)):         # a section
+        assert "σ_c·h²" not in _mesh(quiet)

@@ -264,7 +264,28 @@ def _mesh(s: dict) -> str:
                  f"thinner than the {three_figures(m['h_impact_m'])} m elements: the peak "
                  "principal stress read there is low and grows as the mesh is refined; the "
                  "half-space tension does not depend on the mesh.")
-    return text
+    return text + _crushing_steps(s)
+
+
+def _crushing_steps(s: dict) -> str:
+    """In 3D a crushing end's force is the crushing strength times its crushed area, which
+    the end's elements count: where only a few crush, the force comes in steps of about
+    σ_c·h², and scenarios share one peak force to the last digit. Said where the sample
+    shows it, since such a tie looks like a bug or a cap."""
+    base, m = s.get("base") or {}, s["mesh"]
+    x = (s.get("exceedance") or {}).get("peak_force_filtered_N_per_m", {}).get("x")
+    if s.get("dim") != 3 or not base.get("log_end_crushes") or not x:
+        return ""
+    tied = len(x) - len(set(x))
+    if not tied:
+        return ""
+    step = base["wood_crushing_strength_Pa"] * m["h_contact_m"] ** 2
+    return (f" The crushing end's force is the crushing strength times its crushed area, "
+            f"counted in the end's {three_figures(m['h_contact_m'], 1e3)} mm elements: "
+            f"where only a few of them crush, the force comes in steps of about σ_c·h² = "
+            f"{three_figures(step, 1e-6)} MN, and {tied} of the {len(x)} scenarios share "
+            "their filtered peak force with another (docs/dam.md, \"The 3D sweep's "
+            "trade-off\", gives this end's error).")
 
 
 def _computation(s: dict) -> list:
