@@ -197,9 +197,8 @@ def _met(speedup: float | None, target: float = 1.5) -> str:
 
 
 def run_speedup(r: dict, increments: int = 10) -> float | None:
-    """Serial over two ranks for set-up plus ``increments`` increments, from the measured
-    phases (the case runs four; the ten of a run are its set-up amortised as a user's
-    would be)."""
+    """Serial over two ranks for set-up plus ``increments`` increments, formed from the
+    measured phases: the case itself runs four increments, and (c) is their median."""
     t = {p["key"]: (p["serial_s"], p["np2_s"]) for p in r["phases"]}
     if "setup_s" not in t or "increment_s" not in t:
         return None
