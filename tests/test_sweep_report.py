@@ -136,6 +136,8 @@ def test_a_crushing_ends_force_steps_are_stated_where_scenarios_tie():
     assert ("where only a few of them crush, the force comes in steps of about σ_c·h² = "
             "0.0653 MN, and 2 of the 5 scenarios share their filtered peak force") in tied
     assert "end's 50.0 mm elements" in tied
+    one = _mesh(_crushing_summary([3.27e5, 3.27e5, 4.1e5]))
+    assert "1 of the 3 scenarios shares its filtered peak force with another" in one
     for quiet in (_crushing_summary([3.27e5, 4.1e5, 6.0e5]),           # no tie
                   _crushing_summary([3.27e5, 3.27e5], crushes=False),  # elastic end
                   _crushing_summary([3.27e5, 3.27e5], dim=2)):         # a section

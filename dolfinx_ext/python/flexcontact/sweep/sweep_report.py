@@ -283,9 +283,9 @@ def _crushing_steps(s: dict) -> str:
     return (f" The crushing end's force is the crushing strength times its crushed area, "
             f"counted in the end's {three_figures(m['h_contact_m'], 1e3)} mm elements: "
             f"where only a few of them crush, the force comes in steps of about σ_c·h² = "
-            f"{three_figures(step, 1e-6)} MN, and {tied} of the {len(x)} scenarios share "
-            "their filtered peak force with another (docs/dam.md, \"The 3D sweep's "
-            "trade-off\", gives this end's error).")
+            f"{three_figures(step, 1e-6)} MN, and {tied} of the {len(x)} scenarios "
+            f"{'shares its' if tied == 1 else 'share their'} filtered peak force with another "
+            "(docs/dam.md, \"The 3D sweep's trade-off\", gives this end's error).")
 
 
 def _computation(s: dict) -> list:
