@@ -138,5 +138,6 @@ for r in results:
           "error " + ", ".join(f"{k} {100 * v:.1f} %" for k, v in r["largest_error"].items()))
 Path(args.out).write_text(json.dumps(
     {"what": "3D crushing scenarios on the factored dam block at several meshes",
-     "dt_s": dt, "end": args.end, "zone_m": args.zone_m, "layer_m": args.layer_m, "settings": results,
+     "dt_s": dt, "end": args.end, "zone_m": args.zone_m, "layer_m": args.layer_m,
+     "settings": results,
      "load_average_1min": os.getloadavg()[0], "machine": machine()}, indent=1))

@@ -276,7 +276,7 @@ def _crushing_steps(s: dict) -> str:
     x = (s.get("exceedance") or {}).get("peak_force_filtered_N_per_m", {}).get("x")
     if s.get("dim") != 3 or not base.get("log_end_crushes") or not x:
         return ""
-    tied = len(x) - len(set(x))
+    tied = len(x) - len(set(x))  # each repeated value counted from its second scenario on
     if not tied:
         return ""
     step = base["wood_crushing_strength_Pa"] * m["h_contact_m"] ** 2
@@ -285,7 +285,8 @@ def _crushing_steps(s: dict) -> str:
             f"where only a few of them crush, the force comes in steps of about σ_c·h² = "
             f"{three_figures(step, 1e-6)} MN, and {tied} of the {len(x)} scenarios "
             f"{'shares its' if tied == 1 else 'share their'} filtered peak force with another "
-            "(docs/dam.md, \"The 3D sweep's trade-off\", gives this end's error).")
+            "that came before it in the sample (docs/dam.md, \"The 3D sweep's trade-off\", "
+            "gives this end's error).")
 
 
 def _computation(s: dict) -> list:
