@@ -214,3 +214,36 @@ def test_the_shared_blocks_give_the_dense_kernels_answers(block):
             if k == "evaluate_s" or not isinstance(v, float) or np.isnan(v) or v == 0.0:
                 continue
             assert abs(s[k] - v) <= FHAT_TOL * abs(v), (k, s[k], v)
+
+
+def _first_request_seen(run, seen: list, dam):
+    """``run``'s requests passed on unchanged; the response functions' lags at its first."""
+    ops = next(run)
+    seen.append(dam.responses().lags)
+    while True:
+        answers = yield ops
+        try:
+            ops = run.send(answers)
+        except StopIteration as stop:
+            return stop.value
+
+
+def test_a_run_tabulates_its_response_functions_before_its_first_request(block):
+    """A run that convolves longer than the lags tabulated so far extends them with the
+    dam's factor. Beside other runs, that extension must come before the run's first
+    request: made when it finished, it fell between another run's condensation and its
+    expansion on the dam, and the batch stopped with "expand_many: no condense_many since
+    the last expansion or solve" (16 scenarios of bench/sweep_1000_3d_crushing.toml side
+    by side on an evaluator without a model file)."""
+    from flexcontact.dam.coupled_step import impact_run, run_steps
+    ev = block
+    lags = ev.dam.responses().lags
+    # A slower log approaches for longer: the first speed whose run outlasts the lags.
+    s = next(s for s in (ev.base.replace(log_speed_m_s=v) for v in (0.5, 0.35, 0.25, 0.18))
+             if run_steps(s, ev.dam) > lags)
+    n = run_steps(s, ev.dam)
+    seen: list = []
+    run = impact_run(ev.dam, ev.log_model(s), s, ev.dam.static_state(s.water_level_m))
+    out = serve_alone(_first_request_seen(run, seen, ev.dam))
+    assert seen[0] >= n > lags
+    assert out["steps"] == n and out["dam_steps_convolved"] > 0

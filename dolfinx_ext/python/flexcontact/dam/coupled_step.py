@@ -184,6 +184,11 @@ def impact_run(dam, log, s, static, offset_m: float = 1.0,
     probe = dam.stress_probe(impact, offset_m)
     static_stress = dam.static_stress_Pa(static, probe) if d == 3 else None
     n = run_steps(s, dam)
+    if after_contact == "convolve":
+        # Tabulated now, before this run's first request: the lags it may convolve with
+        # cost back-substitutions with the dam's factor, which must not fall between another
+        # run's condensation and its expansion on that factor (shared_solves).
+        dam.responses().ensure(n)
     records, peak_principal, p_peak = [], -math.inf, 0.0
     section = {q: np.zeros(n) for q in dam.section_gradients}
     impulses = np.zeros((n, dam.face_dofs.size))
