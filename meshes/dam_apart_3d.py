@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _gmsh
-from .dam import dam_faces_3d, downstream_points, log_faces_3d, log_solid
+from .dam_geometry import dam_faces_3d, downstream_points, log_faces_3d, log_solid
 from .dam_tags import DAM, FOUNDATION, LOG, LOG_FRONT, NAMES
 from flexcontact.errors import InputError
 

@@ -36,7 +36,7 @@ def water_on_segment(p1, p2, level_m, rho_g):
 
 
 def _profile_2d(s):
-    from flexcontact.meshes.dam import profile_points
+    from flexcontact.meshes.dam_geometry import profile_points
     return profile_points(s)
 
 
