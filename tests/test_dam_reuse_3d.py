@@ -247,3 +247,42 @@ def test_bad_place_across_the_block(bad, name):
 def test_a_place_across_is_3d_only():
     with pytest.raises(ValueError, match="log_across_m=5.0"):
         DamScenario(log_across_m=5.0)
+
+
+def test_a_saved_models_face_compliance_and_response_functions_take_several_solves_at_once():
+    """The block as a model file prepares it: (K⁻¹)_ii of the face nodes from K's saved
+    factor 128 right-hand sides a solve, equal to one-by-one solves of it (1e-12); the
+    response functions from a plain factor of Ŵ (counted "dam_response"), N's and M's
+    side by side, equal to the adjoint recursion made with the Schur factor's whole solves
+    (1e-12 of the largest, measured 5e-15)."""
+    from flexcontact.dam.dam_model import DamModel
+    from flexcontact.dam.response import TABULATED
+    dam = DamModel(BASE, sweep_time_step_s([BASE]), LEVELS, COMM, saveable=True)
+    c = dam.face_compliance(0)
+    e, x = dam.new_vector(), dam.new_vector()
+    for j in (0, c.size // 2, c.size - 1):
+        i = dam.face_dofs[0::3][j]
+        e.zeroEntries()
+        e.array[i] = 1.0
+        dam._solve1(e, x, "check")
+        assert c[j] == pytest.approx(x.array_r[i], rel=1e-12)
+    G = dam.responses()
+    G.ensure(40)
+    assert dam.counts()["factorizations"]["dam_response"] == 1
+    h, theta = dam.dt, dam.theta
+    for q in TABULATED:
+        a, b = dam.new_vector(), dam.new_vector()
+        a.array[:] = dam.section_gradients[q]
+        rhs, z, Kz = dam.new_vector(), dam.new_vector(), dam.new_vector()
+        ref = []
+        for _ in range(40):
+            rhs.array[:] = h * theta * a.array_r + b.array_r
+            dam.factor.solve(rhs, z)
+            ref.append(z.array_r[dam.face_dofs].copy())
+            dam.K.mult(z, Kz)
+            a_old = a.array_r.copy()
+            a.array[:] = a_old - h * Kz.array_r
+            b.array[:] = h * a_old + b.array_r - h * h * theta * Kz.array_r
+        ref = np.array(ref)
+        assert np.abs(G.G[q][:40] - ref).max() <= 1e-12 * np.abs(ref).max(), q
+    assert dam.response_factor() is not dam.factor    # the Schur factor stays the steps'

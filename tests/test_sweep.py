@@ -574,8 +574,9 @@ def test_default_model_is_the_sweeps_own_prepared_once_and_replaced_if_stale(tmp
 def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):
     """The 3D block: a grid over yaw and the log's place across the block, on the dam
     block's face patch that holds them all. The sweep's dam model factors K and K_eff of
-    the block once each, and the round log; the evaluator restores the three and factors
-    nothing. Every scenario's impulse is the log's loss of momentum along x
+    the block once each (K_eff twice: with its face's Schur complement for the steps, plainly
+    for the response functions), and the round log; the evaluator restores the three and
+    factors nothing. Every scenario's impulse is the log's loss of momentum along x
     (1e-9); the report speaks of the 3D block and of totals, not per metre. With
     --check-convergence the worst are re-run by the monolithic evaluator at refine + 1, whose
     impulse is again the log's loss of momentum (1e-9). (Measured: the worst filtered peak
@@ -590,8 +591,9 @@ def test_3d_reuse_sweep_over_yaw_and_place_factors_the_block_once(tmp_path):
     assert s["counts"]["factorizations"]["total"] == 0, s["counts"]
     assert s["counts"]["restorations"] == {"dam_stage1": 1, "dam_stage2": 1, "log": 1,
                                            "total": 3}, s["counts"]
+    # Ŵ factored once more without its Schur complement, for the response functions.
     assert s["dam_model"]["counts"]["factorizations"] == {"dam_stage1": 1, "dam_stage2": 1,
-                                                          "log": 1}
+                                                          "dam_response": 1, "log": 1}
     c = s["convergence"]["peak_force_filtered_N_per_m"]
     assert c["evaluator_refined"] == "monolithic" and c["refine"] == 0
     fine = c["outputs_refined"]

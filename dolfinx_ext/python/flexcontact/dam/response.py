@@ -18,6 +18,12 @@ G is computed backwards, one output at a time: with λ = (a, b) starting at (g, 
 DOF. Only the normal force and the moment about the centre are tabulated: the heel and toe
 stresses are their linear combinations −N/(Bw) ± 6M/(wB²). Stress components, not
 principal stresses, which are not linear.
+
+The outputs go backwards side by side, their right-hand sides solved together where the
+factor takes several (``solve_many``), with the dam's plain factor of Ŵ where it has one
+(DamModel.response_factor): a full solve on the Schur factor that the contact steps use is
+a condensation, a product with the face's dense F* and an expansion, 87 ms against about
+15 ms at a 51,309-DOF block with 7,410 face DOFs.
 """
 from __future__ import annotations
 
@@ -30,8 +36,8 @@ TABULATED = ("normal_force_N", "moment_centre_Nm")
 class ResponseFunctions:
     """G_j for j < ``n`` of the tabulated quantities of ``dam`` (a DamModel), extended on
     demand (``ensure(n)``) from the adjoint state where the last extension stopped. Each lag
-    costs one back-substitution with the dam's stage-2 factor, counted in
-    ``dam.back_substitutions["dam_response"]``."""
+    costs one back-substitution per quantity with Ŵ's factor (DamModel.response_factor),
+    counted in ``dam.back_substitutions["dam_response"]``."""
 
     def __init__(self, dam):
         self.dam = dam
@@ -47,13 +53,13 @@ class ResponseFunctions:
         """Tabulate at least ``n`` lags."""
         if n <= self.lags:
             return
-        for q in TABULATED:
-            if self._state[q] is None:
-                # Tabulated elsewhere (a model file) without the adjoint state to go on
-                # from: start again from lag 0.
-                self.G[q] = self._backward(q, n)
-            else:
-                self.G[q] = np.vstack([self.G[q], self._backward(q, n - self.G[q].shape[0])])
+        if any(self._state[q] is None for q in TABULATED):
+            # Tabulated elsewhere (a model file) without the adjoint state to go on from:
+            # start again from lag 0.
+            self.G = self._backward(n, fresh=True)
+            return
+        more = self._backward(n - self.lags)
+        self.G = {q: np.vstack([self.G[q], more[q]]) for q in TABULATED}
 
     def saved(self) -> dict:
         """The tabulated G and the adjoint state to go on from, as arrays (a model file)."""
@@ -75,25 +81,43 @@ class ResponseFunctions:
                 b.array[:] = arrays[f"adjoint_b_{q}"]
                 self._state[q] = (a, b)
 
-    def _backward(self, q: str, count: int) -> np.ndarray:
+    def _backward(self, count: int, fresh: bool = False) -> dict:
+        """The next ``count`` lags of every tabulated quantity (from lag 0 if ``fresh``)."""
         dam = self.dam
         h, theta = dam.dt, dam.theta
-        if self._state[q] is None:
-            a, b = dam.new_vector(), dam.new_vector()
-            a.array[:] = dam.section_gradients[q]
-            self._state[q] = (a, b)
-        a, b = self._state[q]
+        if fresh:
+            self._state = {q: None for q in TABULATED}
+        for q in TABULATED:
+            if self._state[q] is None:
+                a, b = dam.new_vector(), dam.new_vector()
+                a.array[:] = dam.section_gradients[q]
+                self._state[q] = (a, b)
+        factor = dam.response_factor()
+        together = hasattr(factor, "solve_many")
         rhs, z, Kz = dam.new_vector(), dam.new_vector(), dam.new_vector()
-        out = np.empty((count, dam.face_dofs.size))
+        out = {q: np.empty((count, dam.face_dofs.size)) for q in TABULATED}
+        B = np.empty((rhs.getSize(), len(TABULATED)), order="F")
         for j in range(count):
-            rhs.array[:] = h * theta * a.array_r + b.array_r
-            dam.factor.solve(rhs, z)
-            dam.back_substitutions["dam_response"] += 1
-            out[j] = z.array_r[dam.face_dofs]
-            dam.K.mult(z, Kz)
-            a_old = a.array_r.copy()
-            a.array[:] = a_old - h * Kz.array_r
-            b.array[:] = h * a_old + b.array_r - h * h * theta * Kz.array_r
+            for c, q in enumerate(TABULATED):
+                a, b = self._state[q]
+                B[:, c] = h * theta * a.array_r + b.array_r
+            if together:
+                Z = factor.solve_many(B)
+            else:
+                Z = np.empty_like(B)
+                for c in range(B.shape[1]):
+                    rhs.array[:] = B[:, c]
+                    factor.solve(rhs, z)
+                    Z[:, c] = z.array_r
+            dam.back_substitutions["dam_response"] += len(TABULATED)
+            for c, q in enumerate(TABULATED):
+                a, b = self._state[q]
+                z.array[:] = Z[:, c]
+                out[q][j] = Z[dam.face_dofs, c]
+                dam.K.mult(z, Kz)
+                a_old = a.array_r.copy()
+                a.array[:] = a_old - h * Kz.array_r
+                b.array[:] = h * a_old + b.array_r - h * h * theta * Kz.array_r
         for v in (rhs, z, Kz):
             v.destroy()
         return out

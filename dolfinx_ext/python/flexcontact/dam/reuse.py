@@ -352,7 +352,8 @@ class ScenarioEvaluator:
                 "steps_s": self._steps_s, **self._split, **shared}
 
     def counts(self) -> dict:
-        """{"factorizations": {"dam_stage1", "dam_stage2", "log"}, "back_substitutions":
+        """{"factorizations": {"dam_stage1", "dam_stage2", "log"} (and "dam_response" where the
+        response functions took a plain factor, DamModel.response_factor), "back_substitutions":
         {same keys}}; "log" sums over every log model made, held or let go."""
         c = self.dam.counts()
         c["factorizations"]["log"] = self.logs.total("factorizations")
