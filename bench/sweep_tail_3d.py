@@ -238,12 +238,14 @@ def main():
     total = screen_wall + (time.perf_counter() - t1)
 
     result = {"what": "the unfavourable tail of a 3D sweep re-run on the main job's mesh",
-              "config": args.config, "top": args.top, "scenarios": len(rows),
+              "config": os.path.relpath(args.config, here.parent), "top": args.top,
+              "scenarios": len(rows),
               "rerun": len(ids), "screened_in_this_run": screened_here,
               "screen_wall_s": screen_wall, "prepare_s": prepare_s, "rerun_wall_s": rerun_s,
               "end_to_end_s": total,
               "rerun_seconds_per_scenario_mean": float(np.mean(seconds)) if seconds else None,
-              "dam_model": model, "dt_s": dt, "mesh": {
+              "dam_model": {k: v for k, v in model.items() if k != "path"}, "dt_s": dt,
+              "mesh": {
                   "screen": driver._element_sizes(base),
                   "main_job": driver._element_sizes(fine_base)},
               "load_average_1min": load0, "machine": describe(),
