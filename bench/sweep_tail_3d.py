@@ -220,12 +220,11 @@ def main():
     print(f"main job's mesh: dam model prepared in {prepare_s:.0f} s", flush=True)
     spec = EvaluatorSpec("reuse", fine_base, dt, (min(levels), max(levels)), face=face,
                          model=str((folder / "dam_model").resolve()), model_if_seen=True)
-    fine, failed, seconds, counts = {}, {}, [], []
+    fine, failed, seconds = {}, {}, []
 
     def on_result(res):
         fine[res["id"]] = res["outputs"]
         seconds.append(res["seconds"])
-        counts.append(res["counts"])
         print(f"  {len(fine)}/{len(ids)} re-run, {time.perf_counter() - t2:.0f} s", flush=True)
 
     t2 = time.perf_counter()

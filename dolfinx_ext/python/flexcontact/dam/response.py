@@ -10,7 +10,7 @@ A quantity q of the base section is linear in w, Δq = g·w, so after step n
 
     Δq_n = Σ_{k<n} G_{n−1−k} · P_k,   G_j = Bᵀ (Aᵀ)ʲ (g, 0).
 
-G is computed backwards, one output at a time: with λ = (a, b) starting at (g, 0),
+G is computed backwards, for each output: with λ = (a, b) starting at (g, 0),
 
     z = Ŵ⁻¹ (hθ a + b),   G_j = S z,   λ ← (a − hKz,  ha + b − h²θ Kz)
 
@@ -94,9 +94,10 @@ class ResponseFunctions:
                 self._state[q] = (a, b)
         factor = dam.response_factor()
         together = hasattr(factor, "solve_many")
-        rhs, z, Kz = dam.new_vector(), dam.new_vector(), dam.new_vector()
+        z, Kz = dam.new_vector(), dam.new_vector()
         out = {q: np.empty((count, dam.face_dofs.size)) for q in TABULATED}
-        B = np.empty((rhs.getSize(), len(TABULATED)), order="F")
+        B = np.empty((z.getSize(), len(TABULATED)), order="F")
+        rhs = None if together else dam.new_vector()
         for j in range(count):
             for c, q in enumerate(TABULATED):
                 a, b = self._state[q]
@@ -119,7 +120,8 @@ class ResponseFunctions:
                 a.array[:] = a_old - h * Kz.array_r
                 b.array[:] = h * a_old + b.array_r - h * h * theta * Kz.array_r
         for v in (rhs, z, Kz):
-            v.destroy()
+            if v is not None:
+                v.destroy()
         return out
 
     def convolve(self, impulses: np.ndarray, n: int) -> dict:
